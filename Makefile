@@ -1,0 +1,82 @@
+# lens2pov: `make` builds build/lens2pov; `make test` runs every test; `make demo` renders the
+# bundled scene. Every build and test target first runs `deps`, which installs the Debian packages
+# that are missing (and does nothing when all are present).
+
+CC       ?= cc
+CXX      ?= c++
+PREFIX   ?= /usr/local
+BUILD    ?= build
+OPT      ?= -O2
+CFLAGS_BASE   = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE $(OPT) -g -Wall -Wextra -Werror
+CXXFLAGS_BASE = -std=c++17 $(OPT) -g -Wall -Wextra -Werror
+SAN      ?=
+LDLIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util) -lstdc++ -lm -lpthread
+
+DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
+               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev
+
+LIB_C   = $(filter-out src/main.c,$(wildcard src/*.c))
+LIB_CXX = $(wildcard src/*.cpp)
+LIB_OBJ = $(LIB_C:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/obj/%.o)
+TEST_C  = $(wildcard tests/*.c)
+TEST_OBJ = $(TEST_C:tests/%.c=$(BUILD)/tobj/%.o)
+
+.PHONY: all deps test test-unit test-sanitize bench demo gallery report stability fuzz install clean
+
+all: $(BUILD)/lens2pov
+
+deps:
+	@sh tools/deps.sh $(DEB_PACKAGES)
+
+$(BUILD)/obj/%.o: src/%.c $(wildcard src/*.h) | $(BUILD)/obj
+	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/%.o: src/%.cpp $(wildcard src/*.h) | $(BUILD)/obj
+	$(CXX) $(CXXFLAGS_BASE) $(SAN) $(CXXFLAGS) $(shell pkg-config --cflags OpenImageIO 2>/dev/null) -c $< -o $@
+
+$(BUILD)/tobj/%.o: tests/%.c $(wildcard src/*.h tests/*.h) | $(BUILD)/tobj
+	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -Isrc -DLENS2POV_SOURCE_DIR='"$(CURDIR)"' -c $< -o $@
+
+$(BUILD)/liblens2pov.a: $(LIB_OBJ)
+	rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/lens2pov: $(BUILD)/obj/main.o $(BUILD)/liblens2pov.a
+	$(CC) $(SAN) $^ -o $@ $(LDLIBS)
+
+$(BUILD)/run_tests: $(TEST_OBJ) $(BUILD)/liblens2pov.a
+	$(CC) $(SAN) $^ -o $@ -lcriterion $(LDLIBS)
+
+$(BUILD)/obj $(BUILD)/tobj:
+	mkdir -p $@
+
+# The test suite runs the built binary too, so it needs both.
+test-unit: $(BUILD)/lens2pov $(BUILD)/run_tests
+	LENS2POV=$(CURDIR)/$(BUILD)/lens2pov $(BUILD)/run_tests $(TEST_ARGS)
+
+test: deps
+	$(MAKE) test-unit
+	$(MAKE) test-sanitize
+
+# The same suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its own build folder.
+test-sanitize: deps
+	$(MAKE) BUILD=build-san OPT=-O1 \
+	  SAN='-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer' \
+	  TEST_ARGS='$(TEST_ARGS) --jobs 2' test-unit
+
+bench: deps $(BUILD)/lens2pov $(BUILD)/bench_trace
+	sh tools/bench.sh $(BUILD)
+
+$(BUILD)/bench_trace: tools/bench_trace.c $(BUILD)/liblens2pov.a
+	$(CC) $(CFLAGS_BASE) -Isrc $^ -o $@ $(LDLIBS)
+
+demo: deps $(BUILD)/lens2pov
+	sh tools/demo.sh $(BUILD)/lens2pov
+
+install: $(BUILD)/lens2pov
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/lens2pov/lenses $(DESTDIR)$(PREFIX)/share/lens2pov/pov
+	install -m 755 $(BUILD)/lens2pov $(DESTDIR)$(PREFIX)/bin/lens2pov
+	install -m 644 lenses/*.dat $(DESTDIR)$(PREFIX)/share/lens2pov/lenses
+	install -m 644 pov/* $(DESTDIR)$(PREFIX)/share/lens2pov/pov
+
+clean:
+	rm -rf build build-san build-fuzz out/tmp

@@ -1,0 +1,116 @@
+#include "outfile.h"
+
+#include <errno.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Temporary paths to remove if a signal ends the run. A fixed table, so that the signal handler
+   only reads memory that is never freed while it is registered. */
+enum { MAX_TRACKED = 256 };
+static char *volatile tracked[MAX_TRACKED];
+
+void outfile_track(const char *temp_path)
+{
+    for (int i = 0; i < MAX_TRACKED; i++)
+        if (!tracked[i]) {
+            tracked[i] = strdup(temp_path);
+            return;
+        }
+}
+
+void outfile_untrack(const char *temp_path)
+{
+    for (int i = 0; i < MAX_TRACKED; i++)
+        if (tracked[i] && strcmp(tracked[i], temp_path) == 0) {
+            char *p = tracked[i];
+            tracked[i] = NULL;
+            free(p);
+            return;
+        }
+}
+
+/* Only async-signal-safe calls here (unlink, rmdir, signal, raise). A registered folder is
+   removed only once its files, registered before it, are gone. */
+static void remove_tracked_and_die(int sig)
+{
+    for (int i = MAX_TRACKED - 1; i >= 0; i--)
+        if (tracked[i] && unlink(tracked[i]) != 0)
+            rmdir(tracked[i]);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+void outfile_install_signal_cleanup(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = remove_tracked_and_die;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGHUP, &sa, NULL);
+}
+
+int outfile_open(outfile *f, const char *path, l2p_error *err)
+{
+    memset(f, 0, sizeof *f);
+    size_t n = strlen(path) + 32;
+    f->final_path = strdup(path);
+    f->temp_path = malloc(n);
+    if (!f->final_path || !f->temp_path) {
+        outfile_discard(f);
+        return l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
+    }
+    snprintf(f->temp_path, n, "%s.tmp%ld", path, (long)getpid());
+    outfile_track(f->temp_path);
+    f->fp = fopen(f->temp_path, "wb");
+    if (!f->fp) {
+        int e = errno;
+        outfile_discard(f);
+        return l2p_fail(err, e == ENOENT || e == ENOTDIR ? L2P_BAD_INPUT : L2P_FAILED, path, 0,
+                        "cannot write: %s", strerror(e));
+    }
+    return L2P_OK;
+}
+
+int outfile_finish(outfile *f, l2p_error *err)
+{
+    if (!f->fp)
+        return L2P_OK;
+    int bad = ferror(f->fp);
+    bad |= fclose(f->fp) != 0;
+    f->fp = NULL;
+    if (bad)
+        return l2p_fail(err, L2P_FAILED, f->final_path, 0, "write failed: %s", strerror(errno));
+    return L2P_OK;
+}
+
+int outfile_commit(outfile *f, l2p_error *err)
+{
+    int st = outfile_finish(f, err);
+    if (st)
+        return st;
+    if (rename(f->temp_path, f->final_path) != 0)
+        return l2p_fail(err, L2P_FAILED, f->final_path, 0, "cannot rename into place: %s",
+                        strerror(errno));
+    outfile_untrack(f->temp_path);
+    free(f->temp_path);
+    free(f->final_path);
+    memset(f, 0, sizeof *f);
+    return L2P_OK;
+}
+
+void outfile_discard(outfile *f)
+{
+    if (f->fp)
+        fclose(f->fp);
+    if (f->temp_path) {
+        unlink(f->temp_path);
+        outfile_untrack(f->temp_path);
+    }
+    free(f->temp_path);
+    free(f->final_path);
+    memset(f, 0, sizeof *f);
+}

@@ -1,0 +1,36 @@
+/* Outputs that are never half-written: each is written to a temporary name beside its final
+   path and renamed into place only when the whole run succeeded. Temporary files are removed
+   on failure and on SIGINT, SIGTERM and SIGHUP. */
+#ifndef LENS2POV_OUTFILE_H
+#define LENS2POV_OUTFILE_H
+
+#include <stdio.h>
+#include "error.h"
+
+typedef struct outfile {
+    FILE *fp;
+    char *final_path;
+    char *temp_path;
+} outfile;
+
+/* Installs the signal handlers that remove registered temporary files. Call once from main. */
+void outfile_install_signal_cleanup(void);
+
+/* Opens a temporary file beside path for writing. */
+int outfile_open(outfile *f, const char *path, l2p_error *err);
+
+/* Flushes and closes the temporary file (checking for write errors) without renaming it. */
+int outfile_finish(outfile *f, l2p_error *err);
+
+/* Renames a finished temporary file to its final path. */
+int outfile_commit(outfile *f, l2p_error *err);
+
+/* Closes if needed and removes the temporary file; safe to call on a committed or unopened file. */
+void outfile_discard(outfile *f);
+
+/* Registers and unregisters any temporary path (files or folders made by other modules) for
+   removal on a signal; register a folder before its files: the handler walks the table from the end. */
+void outfile_track(const char *temp_path);
+void outfile_untrack(const char *temp_path);
+
+#endif
