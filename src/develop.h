@@ -7,8 +7,8 @@
 
 /* Accumulates one rendered chunk image (RGBA, its first row being the row work-around's
    duplicate, dropped) into sums of weight * colour per film pixel of the crop. sums holds
-   3 floats per crop pixel, in doubles for exactness. Pixels with alpha 0 (no face) and faces
-   past the table's end are ignored. */
+   3 doubles per crop pixel. Alpha is not used: pixels past the table's last face (which POV-Ray
+   leaves black) are recognised by their index. */
 int develop_accumulate(const samplemap *map, long long chunk, const float *rgba, int width,
                        int height, double *sums, l2p_error *err);
 
