@@ -4,11 +4,12 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 /* Temporary paths to remove if a signal ends the run. A fixed table, so that the signal handler
    only reads memory that is never freed while it is registered. */
-enum { MAX_TRACKED = 256 };
+enum { MAX_TRACKED = 4096 };
 static char *volatile tracked[MAX_TRACKED];
 
 void outfile_track(const char *temp_path)
@@ -31,13 +32,54 @@ void outfile_untrack(const char *temp_path)
         }
 }
 
-/* Only async-signal-safe calls here (unlink, rmdir, signal, raise). A registered folder is
-   removed only once its files, registered before it, are gone. */
+/* Child processes to stop with us (POV-Ray), and their count. */
+enum { MAX_CHILDREN = 256 };
+static volatile pid_t children[MAX_CHILDREN];
+
+void outfile_track_child(pid_t pid)
+{
+    for (int i = 0; i < MAX_CHILDREN; i++)
+        if (!children[i]) {
+            children[i] = pid;
+            return;
+        }
+}
+
+void outfile_untrack_child(pid_t pid)
+{
+    for (int i = 0; i < MAX_CHILDREN; i++)
+        if (children[i] == pid)
+            children[i] = 0;
+}
+
+/* A folder, with whatever is in it, goes through rm -rf in a child process: fork, execve and
+   waitpid are async-signal-safe, readdir is not. */
+static void remove_path(const char *path)
+{
+    if (unlink(path) == 0 || rmdir(path) == 0)
+        return;
+    pid_t pid = fork();
+    if (pid == 0) {
+        char *const argv[] = {"rm", "-rf", "--", (char *)path, NULL};
+        char *const envp[] = {NULL};
+        execve("/bin/rm", argv, envp);
+        _exit(127);
+    }
+    if (pid > 0)
+        waitpid(pid, NULL, 0);
+}
+
+/* Only async-signal-safe calls here. */
 static void remove_tracked_and_die(int sig)
 {
+    for (int i = 0; i < MAX_CHILDREN; i++)
+        if (children[i] > 0) {
+            kill(children[i], SIGTERM);
+            waitpid(children[i], NULL, 0);
+        }
     for (int i = MAX_TRACKED - 1; i >= 0; i--)
-        if (tracked[i] && unlink(tracked[i]) != 0)
-            rmdir(tracked[i]);
+        if (tracked[i])
+            remove_path(tracked[i]);
     signal(sig, SIG_DFL);
     raise(sig);
 }

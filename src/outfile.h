@@ -5,6 +5,7 @@
 #define LENS2POV_OUTFILE_H
 
 #include <stdio.h>
+#include <sys/types.h>
 #include "error.h"
 
 typedef struct outfile {
@@ -28,9 +29,13 @@ int outfile_commit(outfile *f, l2p_error *err);
 /* Closes if needed and removes the temporary file; safe to call on a committed or unopened file. */
 void outfile_discard(outfile *f);
 
-/* Registers and unregisters any temporary path (files or folders made by other modules) for
-   removal on a signal; register a folder before its files: the handler walks the table from the end. */
+/* Registers and unregisters any temporary path (a file, or a folder with everything in it)
+   for removal on a signal. */
 void outfile_track(const char *temp_path);
 void outfile_untrack(const char *temp_path);
+
+/* Child processes to terminate (SIGTERM, then wait) before the handler removes the files. */
+void outfile_track_child(pid_t pid);
+void outfile_untrack_child(pid_t pid);
 
 #endif

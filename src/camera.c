@@ -1,0 +1,240 @@
+#include "camera.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include "focus.h"
+
+void camera_options_default(camera_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = 640;
+    o->height = 480;
+    o->spp = 16;
+    o->film_diagonal_mm = 35.0;
+    o->film_distance_mm = o->focus_distance_units = NAN;
+    o->aperture_diameter_mm = o->f_number = NAN;
+    o->pupil = PUPIL_STOP_IMAGE;
+    o->trace = TRACE_KIND_FULL;
+    o->location = v3(0, 0, 0);
+    o->look_at = v3(0, 0, 1);
+    o->sky = v3(0, 1, 0);
+    o->unit_mm = 1000.0;
+    o->weighting = WEIGHTING_NORMALIZED;
+}
+
+static int setup_placement(camera *c, const camera_options *o, l2p_error *err)
+{
+    const vec3 ahead = v3_sub(o->look_at, o->location);
+    if (!(v3_length(ahead) > 0.0))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--look-at must differ from --location");
+    c->forward = v3_normalize(ahead);
+    const vec3 side = v3_cross(o->sky, c->forward);
+    if (!(v3_length(side) > 1e-12 * v3_length(o->sky)))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--sky must not be parallel to the viewing direction");
+    c->right = v3_normalize(side);
+    c->up = v3_cross(c->forward, c->right);
+    c->location = o->location;
+    c->unit_mm = o->unit_mm;
+    return L2P_OK;
+}
+
+vec3 camera_world_from_camera_point(const camera *c, vec3 p)
+{
+    const vec3 m = v3_add(v3_add(v3_scale(c->right, p.x), v3_scale(c->up, p.y)),
+                          v3_scale(c->forward, p.z));
+    return v3_add(c->location, v3_scale(m, 1.0 / c->unit_mm));
+}
+
+vec3 camera_world_from_camera_dir(const camera *c, vec3 d)
+{
+    return v3_normalize(v3_add(v3_add(v3_scale(c->right, d.x), v3_scale(c->up, d.y)),
+                               v3_scale(c->forward, d.z)));
+}
+
+int camera_entrance_pupil(const lens *l, double *z_mm, double *radius_mm, l2p_error *err)
+{
+    const lens_surface *stop = &l->surface[l->stop];
+    if (l->stop == 0) {
+        *z_mm = stop->vertex_z_mm;
+        *radius_mm = 0.5 * l->stop_diameter_mm;
+        return L2P_OK;
+    }
+    thick_lens front;
+    int st = thick_lens_of(l, 0, l->stop - 1, &front, err);
+    if (st)
+        return st;
+    vec3 rim;
+    if (!thick_real_from_image(&front, v3(0.5 * l->stop_diameter_mm, 0, stop->vertex_z_mm), &rim))
+        return l2p_fail(err, L2P_BAD_INPUT, l->path, stop->line,
+                        "the entrance pupil is at infinity (the stop is in the rear focal plane "
+                        "of the surfaces in front of it)");
+    *z_mm = rim.z;
+    *radius_mm = fabs(rim.x);
+    return L2P_OK;
+}
+
+/* The stop opening for --aperture-diameter or --f-number (N = f / entrance pupil diameter;
+   the entrance pupil scales with the stop). */
+static int setup_aperture(lens *l, const camera_options *o, double efl_mm, l2p_error *err)
+{
+    const double full = l->surface[l->stop].aperture_mm;
+    double diameter = full;
+    if (!isnan(o->aperture_diameter_mm)) {
+        diameter = o->aperture_diameter_mm;
+    } else if (!isnan(o->f_number)) {
+        double z, r;
+        int st = camera_entrance_pupil(l, &z, &r, err);
+        if (st)
+            return st;
+        const double magnification = 2.0 * r / l->stop_diameter_mm;
+        diameter = efl_mm / (o->f_number * magnification);
+        if (diameter > full * (1.0 + 1e-12))
+            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                            "--f-number %g is faster than the lens: its widest is f/%.4g",
+                            o->f_number, efl_mm / (full * magnification));
+    }
+    if (!(diameter > 0.0) || diameter > full * (1.0 + 1e-12))
+        return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[l->stop].line,
+                        "aperture diameter %g mm is not in (0, %g], the stop's opening",
+                        diameter, full);
+    l->stop_diameter_mm = fmin(diameter, full);
+    return L2P_OK;
+}
+
+static int setup_focus(camera *c, const camera_options *o, l2p_error *err)
+{
+    lens *l = &c->lens;
+    if (!isnan(o->film_distance_mm)) {
+        if (!(o->film_distance_mm >= 0.0))
+            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--film-distance must be >= 0");
+        lens_set_film_distance(l, o->film_distance_mm);
+    } else {
+        double units = o->focus_distance_units;
+        if (isnan(units))
+            units = v3_length(v3_sub(o->look_at, o->location));
+        if (!(units > 0.0))
+            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--focus-distance must be positive");
+        int st = focus_set(l, units * o->unit_mm, o->unit_mm, err);
+        if (st)
+            return st;
+    }
+    c->focus_distance_units = focus_distance_mm(l) / o->unit_mm;
+    return L2P_OK;
+}
+
+/* The mean weight over a fine stratified grid of the pupil at the film centre, blocked rays
+   counting 0: the scale that makes it 1 makes the centre as bright as a pinhole camera. */
+static double centre_mean_weight(const camera *c)
+{
+    enum { N = 48 };
+    double sum = 0.0;
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            ray r;
+            double w;
+            if (camera_trace(c, v3(0, 0, 0), (i + 0.5) / N, (j + 0.5) / N, &r, &w))
+                sum += w;
+        }
+    return sum / (N * N);
+}
+
+static int setup_weights(camera *c, weighting w, l2p_error *err)
+{
+    c->weighting = w;
+    c->weight_scale = 1.0;
+    if (w == WEIGHTING_PHYSICAL)
+        return L2P_OK;
+    const double mean = centre_mean_weight(c);
+    if (!(mean > 0.0))
+        return l2p_fail(err, L2P_BAD_INPUT, c->lens.path, 0,
+                        "the lens blocks every ray at the film centre: nothing to normalize "
+                        "against (use --weighting physical)");
+    c->weight_scale = 1.0 / mean;
+    return L2P_OK;
+}
+
+static int setup_film(camera *c, const camera_options *o, l2p_error *err)
+{
+    if (o->width <= 0 || o->height <= 0 || o->spp <= 0)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--width, --height and --spp must be positive");
+    if (!(o->film_diagonal_mm > 0.0) || !isfinite(o->film_diagonal_mm))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--film-diagonal must be positive");
+    if (!(o->unit_mm > 0.0) || !isfinite(o->unit_mm))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--unit-mm must be positive");
+    film_init(&c->film, o->width, o->height, o->film_diagonal_mm);
+    sample_pattern_init(&c->samples, o->spp, o->seed);
+    c->crop_x0 = o->crop_x0;
+    c->crop_y0 = o->crop_y0;
+    c->crop_x1 = o->crop_x1 ? o->crop_x1 : o->width;
+    c->crop_y1 = o->crop_y1 ? o->crop_y1 : o->height;
+    if (c->crop_x0 < 0 || c->crop_y0 < 0 || c->crop_x1 > o->width || c->crop_y1 > o->height ||
+        c->crop_x0 >= c->crop_x1 || c->crop_y0 >= c->crop_y1)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--crop %d,%d,%d,%d is not a region of the %dx%d film (X0,Y0 inclusive, "
+                        "X1,Y1 exclusive)", c->crop_x0, c->crop_y0, c->crop_x1, c->crop_y1,
+                        o->width, o->height);
+    return L2P_OK;
+}
+
+int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
+{
+    memset(c, 0, sizeof *c);
+    c->lens = *l;
+    memset(l, 0, sizeof *l);
+    c->trace = o->trace;
+    int st = setup_film(c, o, err);
+    if (!st)
+        st = setup_placement(c, o, err);
+    if (!st)
+        st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->whole, err);
+    if (!st)
+        st = setup_aperture(&c->lens, o, thick_efl_mm(&c->whole), err);
+    if (!st)
+        st = setup_focus(c, o, err);
+    if (!st)
+        st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->whole, err);
+    if (!st)
+        st = pupil_make(&c->lens, o->pupil, &c->pupil, err);
+    if (!st) {
+        double z, r;
+        st = camera_entrance_pupil(&c->lens, &z, &r, err);
+        c->f_number = thick_efl_mm(&c->whole) / (2.0 * r);
+    }
+    if (!st)
+        st = setup_weights(c, o->weighting, err);
+    return st;
+}
+
+void camera_free(camera *c)
+{
+    lens_free(&c->lens);
+    memset(c, 0, sizeof *c);
+}
+
+/* Thick tracing leaves the ray on P1; start it where a real lens's rays start, on the plane of
+   the front vertex, so both kinds of trace see the same scene in front of the lens. */
+static bool trace_thick(const camera *c, ray *r)
+{
+    if (!thick_trace_toward_scene(&c->whole, r))
+        return false;
+    const double t = (c->lens.surface[0].vertex_z_mm - r->o.z) / r->d.z;
+    r->o = v3_madd(r->o, r->d, t);
+    return v3_isfinite(r->o);
+}
+
+bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight)
+{
+    ray r = {film_point, v3(0, 0, 1)};
+    const double w = pupil_film_ray(&c->pupil, film_point, u, v, &r.d);
+    if (!(w > 0.0) || !v3_isfinite(r.d))
+        return false;
+    bool passed = c->trace == TRACE_KIND_THICK
+                      ? trace_thick(c, &r)
+                      : trace_toward_scene(&c->lens, 0, c->lens.count - 1, &r, NULL) == TRACE_PASSED;
+    if (!passed || !v3_isfinite(r.o) || !v3_isfinite(r.d))
+        return false;
+    *out = r;
+    *weight = w * c->weight_scale;
+    return isfinite(*weight);
+}

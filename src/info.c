@@ -1,0 +1,109 @@
+#include "info.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
+{
+    lens l;
+    if (lens_copy(&l, src))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    l.stop_diameter_mm = l.surface[l.stop].aperture_mm;
+    lens_set_film_distance(&l, 0.0);
+    thick_lens t;
+    pupil exit;
+    double ep_z, ep_r;
+    int st = thick_lens_of(&l, 0, l.count - 1, &t, err);
+    if (!st)
+        st = camera_entrance_pupil(&l, &ep_z, &ep_r, err);
+    if (!st)
+        st = pupil_make(&l, PUPIL_STOP_IMAGE, &exit, err);
+    if (!st) {
+        memset(out, 0, sizeof *out);
+        out->efl_mm = thick_efl_mm(&t);
+        out->bfd_mm = -t.f2_mm;   /* rear vertex (z = 0 here) to F2, toward the film */
+        out->ffd_mm = t.f1_mm - l.surface[0].vertex_z_mm;
+        out->f_number = out->efl_mm / (2.0 * ep_r);
+        out->stop_diameter_mm = l.stop_diameter_mm;
+        out->total_length_mm = lens_total_length_mm(&l);
+        out->p1_from_rear_mm = t.p1_mm;
+        out->p2_from_rear_mm = t.p2_mm;
+        out->entrance_pupil_from_rear_mm = ep_z;
+        out->entrance_pupil_diameter_mm = 2.0 * ep_r;
+        out->exit_pupil_from_rear_mm = exit.z_mm;
+        out->exit_pupil_diameter_mm = 2.0 * exit.radius_mm;
+    }
+    lens_free(&l);
+    return st;
+}
+
+/* Half field angle, degrees: the chief ray from film point p, aimed at the centre of the exit
+   pupil, traced out of the lens; NAN when the lens blocks it. */
+static double half_field_deg(const camera *c, vec3 p)
+{
+    ray r;
+    double w;
+    if (!camera_trace(c, p, 0.5, 0.5, &r, &w))
+        return NAN;
+    return acos(fmin(1.0, r.d.z)) * 180.0 / M_PI;
+}
+
+typedef struct field { const char *key, *label, *unit; double value; } field;
+
+static void print_fields(FILE *out, const field *f, int n, bool json)
+{
+    for (int i = 0; i < n; i++) {
+        const char *comma = i + 1 < n ? "," : "";
+        if (json && isfinite(f[i].value))
+            fprintf(out, "  \"%s\": %.10g%s\n", f[i].key, f[i].value, comma);
+        else if (json)
+            fprintf(out, "  \"%s\": null%s\n", f[i].key, comma);
+        else
+            fprintf(out, "%-34s %12.6g %s\n", f[i].label, f[i].value, f[i].unit);
+    }
+}
+
+void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, bool json)
+{
+    field f[32] = {
+        {"efl_mm", "effective focal length", "mm", li->efl_mm},
+        {"bfd_mm", "back focal distance", "mm", li->bfd_mm},
+        {"ffd_mm", "front focal distance", "mm", li->ffd_mm},
+        {"f_number", "f-number at full stop", "", li->f_number},
+        {"stop_diameter_mm", "stop diameter", "mm", li->stop_diameter_mm},
+        {"total_length_mm", "total length (front to rear vertex)", "mm", li->total_length_mm},
+        {"front_principal_plane_mm", "front principal plane (from rear)", "mm", li->p1_from_rear_mm},
+        {"rear_principal_plane_mm", "rear principal plane (from rear)", "mm", li->p2_from_rear_mm},
+        {"entrance_pupil_mm", "entrance pupil (from rear)", "mm", li->entrance_pupil_from_rear_mm},
+        {"entrance_pupil_diameter_mm", "entrance pupil diameter", "mm", li->entrance_pupil_diameter_mm},
+        {"exit_pupil_mm", "exit pupil (from rear)", "mm", li->exit_pupil_from_rear_mm},
+        {"exit_pupil_diameter_mm", "exit pupil diameter", "mm", li->exit_pupil_diameter_mm},
+    };
+    int n = 12;
+    if (c) {
+        const film *fi = &c->film;
+        field more[] = {
+            {"film_distance_mm", "film distance", "mm", c->lens.film_distance_mm},
+            {"focus_distance", "focus distance (film to subject)", "units", c->focus_distance_units},
+            {"working_f_number", "f-number (this aperture)", "", c->f_number},
+            {"aperture_diameter_mm", "aperture diameter", "mm", c->lens.stop_diameter_mm},
+            {"hfov_deg", "horizontal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0, 0))},
+            {"vfov_deg", "vertical field of view", "deg", 2 * half_field_deg(c, v3(0, 0.5 * fi->height_mm, 0))},
+            {"dfov_deg", "diagonal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0.5 * fi->height_mm, 0))},
+        };
+        memcpy(f + n, more, sizeof more);
+        n += (int)(sizeof more / sizeof more[0]);
+    }
+    if (json) {
+        fputs("{\n  \"lens\": \"", out);
+        for (const char *p = l->name; *p; p++)
+            fprintf(out, *p == '"' || *p == '\\' ? "\\%c" : (unsigned char)*p < 32 ? "\\u%04x" : "%c", *p);
+        fputs("\",\n", out);
+    }
+    else
+        fprintf(out, "%s (%d surfaces, stop on line %d)\n", l->path, l->count,
+                l->surface[l->stop].line);
+    print_fields(out, f, n, json);
+    if (json)
+        fprintf(out, "}\n");
+}

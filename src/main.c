@@ -1,0 +1,139 @@
+/* lens2pov: render POV-Ray scenes through real camera lenses. The command line. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "camera.h"
+#include "cli.h"
+#include "develop.h"
+#include "info.h"
+#include "outfile.h"
+#include "raytable.h"
+#include "render.h"
+
+static const char usage[] =
+    "usage:\n"
+    "  lens2pov info LENS [--json] [camera options]\n"
+    "  lens2pov trace LENS [camera options] -o PREFIX [--rays FILE.csv]\n"
+    "  lens2pov develop PREFIX RENDER.exr -o IMAGE      (.png, .exr or .tif)\n"
+    "  lens2pov render SCENE.pov LENS [camera options] -o IMAGE [--jobs N] [--keep-temp DIR]\n"
+    "camera options:\n"
+    "  --width N --height N --spp N --film-diagonal MM --crop X0,Y0,X1,Y1\n"
+    "  --film-distance MM | --focus-distance UNITS|inf\n"
+    "  --aperture-diameter MM | --f-number N\n"
+    "  --pupil stop|rear|stop-image --trace full|thick --weighting normalized|physical\n"
+    "  --location X,Y,Z --look-at X,Y,Z --sky X,Y,Z --unit-mm MM --seed N\n"
+    "See README.md for the conventions.\n";
+
+static int fail(const l2p_error *err)
+{
+    fprintf(stderr, "lens2pov: %s\n", err->text);
+    return err->status ? err->status : L2P_FAILED;
+}
+
+static int need(const cli *c, int positional, bool output, l2p_error *err)
+{
+    if (c->positional_count != positional)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "expected %d argument%s, got %d (see --help)",
+                        positional, positional == 1 ? "" : "s", c->positional_count);
+    if (output && !c->output)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "-o is required");
+    return L2P_OK;
+}
+
+static int load_camera(const cli *c, const char *lens_path, camera *cam, l2p_error *err)
+{
+    lens l;
+    int st = lens_read(lens_path, &l, err);
+    if (st)
+        return st;
+    st = camera_setup(cam, &l, &c->cam, err);
+    if (st)
+        camera_free(cam);
+    return st;
+}
+
+static int cmd_info(const cli *c, l2p_error *err)
+{
+    int st = need(c, 1, false, err);
+    lens l;
+    if (st || (st = lens_read(c->positional[0], &l, err)))
+        return st;
+    lens_info li;
+    camera cam;
+    bool with_camera = c->film_given;
+    if (!(st = lens_info_of(&l, &li, err)) && with_camera) {
+        lens copy;
+        st = lens_copy(&copy, &l) ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
+                                  : camera_setup(&cam, &copy, &c->cam, err);
+        if (st)
+            camera_free(&cam);
+    }
+    if (!st)
+        info_print(stdout, &l, &li, with_camera ? &cam : NULL, c->json);
+    if (with_camera && !st)
+        camera_free(&cam);
+    lens_free(&l);
+    return st;
+}
+
+static int cmd_trace(const cli *c, l2p_error *err)
+{
+    camera cam;
+    int st = need(c, 1, true, err);
+    if (st || (st = load_camera(c, c->positional[0], &cam, err)))
+        return st;
+    raytable_stats stats;
+    st = raytable_write(&cam, c->output, c->rays_csv, 0, !c->quiet, NULL, NULL, &stats, err);
+    if (!st && !c->quiet)
+        fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%), %.2f s\n",
+                stats.passed, stats.samples, 100.0 * (double)stats.passed / (double)stats.samples,
+                stats.seconds);
+    camera_free(&cam);
+    return st;
+}
+
+static int cmd_develop(const cli *c, l2p_error *err)
+{
+    int st = need(c, 2, true, err);
+    if (st)
+        return st;
+    char *map_path = malloc(strlen(c->positional[0]) + 8);
+    if (!map_path)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    sprintf(map_path, "%s.map", c->positional[0]);
+    samplemap map;
+    st = samplemap_read(map_path, &map, err);
+    free(map_path);
+    if (st)
+        return st;
+    const char *renders[1] = {c->positional[1]};
+    st = develop_files(&map, renders, 1, c->output, err);
+    samplemap_free(&map);
+    return st;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        fputs(usage, argc < 2 ? stderr : stdout);
+        return argc < 2 ? L2P_BAD_INPUT : L2P_OK;
+    }
+    outfile_install_signal_cleanup();
+    l2p_error err = {0, ""};
+    cli c;
+    int st = cli_parse(&c, argc, argv, 2, &err);
+    if (st)
+        return fail(&err);
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "info"))
+        st = cmd_info(&c, &err);
+    else if (!strcmp(cmd, "trace"))
+        st = cmd_trace(&c, &err);
+    else if (!strcmp(cmd, "develop"))
+        st = cmd_develop(&c, &err);
+    else if (!strcmp(cmd, "render"))
+        st = render_command(&c, &err);
+    else
+        st = l2p_fail(&err, L2P_BAD_INPUT, NULL, 0, "unknown command '%s' (see --help)", cmd);
+    return st ? fail(&err) : L2P_OK;
+}

@@ -1,0 +1,478 @@
+#include "povmesh.h"
+
+#include <inttypes.h>
+#include <stdlib.h>
+#include <string.h>
+#include "outfile.h"
+#include "samplemap.h"
+
+enum { BUFFER_BYTES = 1 << 20, MAX_PACKED_WIDTH = 1024, COUNT_FIELD = 20 };
+
+/* Text written through a large buffer with a hand-made fixed-point formatter: printf's %g
+   costs several times the rest of the ray's work. */
+typedef struct text_out {
+    outfile file;
+    char *buf;
+    size_t len;
+} text_out;
+
+typedef struct chunk {
+    text_out inc;
+    outfile ini;
+    long count_offset;      /* where the vertex count goes, filled in at the end */
+    long long faces;
+} chunk;
+
+struct povmesh_emitter {
+    const camera *cam;
+    char *prefix;
+    long long chunk_faces;     /* 0: one chunk */
+    int packed_width;
+    chunk *chunks;
+    int chunk_count;
+    outfile map;
+    text_out csv;
+    bool has_csv;
+    long long faces;
+    vec3 anchor_camera_mm;     /* the front vertex: vertices are written relative to it */
+    double triangle_size;      /* scene units */
+    int decimals;
+    double decimal_scale, fixed_limit;
+};
+
+static int flush_text(text_out *t, l2p_error *err)
+{
+    if (t->len && fwrite(t->buf, 1, t->len, t->file.fp) != t->len)
+        return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "write failed");
+    t->len = 0;
+    return L2P_OK;
+}
+
+static void put_text(text_out *t, const char *s, size_t n)
+{
+    memcpy(t->buf + t->len, s, n);
+    t->len += n;
+}
+
+static void put_str(text_out *t, const char *s) { put_text(t, s, strlen(s)); }
+
+static void put_uint(text_out *t, uint64_t v)
+{
+    char tmp[24];
+    int n = 0;
+    do {
+        tmp[n++] = (char)('0' + v % 10);
+        v /= 10;
+    } while (v);
+    while (n)
+        t->buf[t->len++] = tmp[--n];
+}
+
+/* v to e->decimals decimals; values past the fixed-point range fall back to %.9g. */
+static void put_number(text_out *t, const povmesh_emitter *e, double v)
+{
+    if (!(fabs(v) < e->fixed_limit)) {
+        t->len += (size_t)snprintf(t->buf + t->len, 32, "%.9g", v);
+        return;
+    }
+    int64_t k = llround(v * e->decimal_scale);
+    if (k < 0) {
+        t->buf[t->len++] = '-';
+        k = -k;
+    }
+    uint64_t whole = (uint64_t)k, frac = 0, p = 1;
+    for (int i = 0; i < e->decimals; i++)
+        p *= 10;
+    frac = whole % p;
+    whole /= p;
+    put_uint(t, whole);
+    if (e->decimals == 0)
+        return;
+    t->buf[t->len++] = '.';
+    for (int i = e->decimals - 1; i >= 0; i--) {
+        t->buf[t->len + (size_t)i] = (char)('0' + frac % 10);
+        frac /= 10;
+    }
+    t->len += (size_t)e->decimals;
+}
+
+static int reserve(text_out *t, size_t n, l2p_error *err)
+{
+    return t->len + n > BUFFER_BYTES ? flush_text(t, err) : L2P_OK;
+}
+
+void povmesh_triangle(vec3 o, vec3 d, double size, vec3 v[3])
+{
+    /* a, b span the plane normal to d with a x b = d; vertices at 0, 240 and 120 degrees give
+       (P3 - P1) x (P2 - P1) = +k d, the winding POV-Ray turns into direction d. */
+    const vec3 helper = fabs(d.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
+    const vec3 a = v3_normalize(v3_cross(d, helper));
+    const vec3 b = v3_cross(d, a);
+    const double c = -0.5 * size, s = 0.8660254037844386 * size;
+    v[0] = v3_madd(o, a, size);
+    v[1] = v3_add(o, v3_add(v3_scale(a, c), v3_scale(b, -s)));
+    v[2] = v3_add(o, v3_add(v3_scale(a, c), v3_scale(b, s)));
+}
+
+static char *chunk_path(const povmesh_emitter *e, int index, const char *ext)
+{
+    size_t n = strlen(e->prefix) + 32;
+    char *p = malloc(n);
+    if (!p)
+        return NULL;
+    if (e->chunk_faces == 0)
+        snprintf(p, n, "%s.%s", e->prefix, ext);
+    else
+        snprintf(p, n, "%s.c%03d.%s", e->prefix, index, ext);
+    return p;
+}
+
+static int open_text(text_out *t, const char *path, l2p_error *err)
+{
+    t->len = 0;
+    t->buf = malloc(BUFFER_BYTES + 4096);
+    if (!t->buf)
+        return l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
+    return outfile_open(&t->file, path, err);
+}
+
+static void discard_text(text_out *t)
+{
+    outfile_discard(&t->file);
+    free(t->buf);
+    t->buf = NULL;
+}
+
+static int begin_chunk(povmesh_emitter *e, l2p_error *err)
+{
+    chunk *grown = realloc(e->chunks, sizeof *grown * (size_t)(e->chunk_count + 1));
+    if (!grown)
+        return l2p_fail(err, L2P_FAILED, e->prefix, 0, "out of memory");
+    e->chunks = grown;
+    chunk *ch = &e->chunks[e->chunk_count++];
+    memset(ch, 0, sizeof *ch);
+    char *path = chunk_path(e, e->chunk_count - 1, "inc");
+    int st = path ? open_text(&ch->inc, path, err) : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    free(path);
+    if (st)
+        return st;
+    text_out *t = &ch->inc;
+    t->len += (size_t)snprintf(t->buf, 256,
+        "// lens2pov ray table: one triangle per ray for mesh_camera (distribution 0).\n"
+        "#declare Lens2pov_Version = version;\n#version 3.7;\n"
+        "#declare Lens2pov_Rays = mesh2 {\n  vertex_vectors {");
+    ch->count_offset = (long)t->len;
+    t->len += (size_t)snprintf(t->buf + t->len, 64, "%*s,\n", COUNT_FIELD, "");
+    return L2P_OK;
+}
+
+static void put_vertex(text_out *t, const povmesh_emitter *e, vec3 v)
+{
+    t->buf[t->len++] = '<';
+    put_number(t, e, v.x);
+    t->buf[t->len++] = ',';
+    put_number(t, e, v.y);
+    t->buf[t->len++] = ',';
+    put_number(t, e, v.z);
+    put_text(t, ">,\n", 3);
+}
+
+/* Vertices of one ray, relative to the anchor, in scene units. */
+static void put_ray(text_out *t, const povmesh_emitter *e, const ray *r)
+{
+    const camera *c = e->cam;
+    const vec3 rel = v3_sub(r->o, e->anchor_camera_mm);
+    const vec3 o = v3_scale(v3_add(v3_add(v3_scale(c->right, rel.x), v3_scale(c->up, rel.y)),
+                                   v3_scale(c->forward, rel.z)), 1.0 / c->unit_mm);
+    vec3 v[3];
+    povmesh_triangle(o, camera_world_from_camera_dir(c, r->d), e->triangle_size, v);
+    for (int k = 0; k < 3; k++)
+        put_vertex(t, e, v[k]);
+}
+
+static void put_faces(text_out *t, long long first, long long count)
+{
+    for (long long k = 0; k < count; k++) {
+        const uint64_t a = 3 * (uint64_t)(first + k);
+        t->buf[t->len++] = '<';
+        put_uint(t, a);
+        t->buf[t->len++] = ',';
+        put_uint(t, a + 1);
+        t->buf[t->len++] = ',';
+        put_uint(t, a + 2);
+        put_text(t, ">,\n", 3);
+    }
+}
+
+static int write_faces(text_out *t, long long count, l2p_error *err)
+{
+    t->len += (size_t)snprintf(t->buf + t->len, 64, "  }\n  face_indices { %lld,\n", count);
+    /* A face takes at most 3 * 20 + 6 bytes; batches of 4096 fit in 4096 * 72. */
+    for (long long done = 0; done < count;) {
+        const long long n = count - done < 4096 ? count - done : 4096;
+        int st = reserve(t, 4096 * 72, err);
+        if (st)
+            return st;
+        put_faces(t, done, n);
+        done += n;
+    }
+    return L2P_OK;
+}
+
+/* The camera: the mesh moved to the lens with a double-precision translate. */
+static void put_camera(text_out *t, const povmesh_emitter *e)
+{
+    const vec3 w = camera_world_from_camera_point(e->cam, e->anchor_camera_mm);
+    t->len += (size_t)snprintf(t->buf + t->len, 512,
+        "  }\n}\ncamera {\n  mesh_camera {\n    1 0\n"
+        "    mesh { Lens2pov_Rays translate <%.17g, %.17g, %.17g> }\n  }\n}\n"
+        "#undef Lens2pov_Rays\n#version Lens2pov_Version;\n", w.x, w.y, w.z);
+}
+
+static int write_ini(povmesh_emitter *e, chunk *ch, int index, long long rows, l2p_error *err)
+{
+    char *path = chunk_path(e, index, "ini"), *exr = chunk_path(e, index, "exr");
+    int st = path && exr ? outfile_open(&ch->ini, path, err)
+                         : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    if (!st)
+        fprintf(ch->ini.fp,
+                "; lens2pov: POV-Ray settings for the ray table beside this file.\n"
+                "; Row 0 of the image repeats row 1 (POV-Ray 3.7.0.10, FS#254): one row more.\n"
+                "Width=%d\nHeight=%lld\nAntialias=Off\nOutput_File_Type=E\nOutput_To_File=On\n"
+                "Output_File_Name=%s\nDisplay=Off\n", e->packed_width, rows + 1, exr);
+    free(path);
+    free(exr);
+    return st ? st : outfile_finish(&ch->ini, err);
+}
+
+static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)
+{
+    chunk *ch = &e->chunks[index];
+    text_out *t = &ch->inc;
+    long long faces = ch->faces;
+    int st = reserve(t, 1024, err);
+    if (st)
+        return st;
+    if (faces == 0) {          /* nothing passed the lens: one zero-area face, a ray to nowhere */
+        put_str(t, "<0,0,0>,<0,0,0>,<0,0,0>,\n");
+        faces = 1;
+    }
+    st = write_faces(t, faces, err);
+    if (st)
+        return st;
+    put_camera(t, e);
+    if ((st = flush_text(t, err)) != 0)
+        return st;
+    if (fseek(t->file.fp, ch->count_offset, SEEK_SET) != 0 ||
+        fprintf(t->file.fp, "%*lld", COUNT_FIELD, 3 * faces) != COUNT_FIELD)
+        return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "write failed");
+    if ((st = outfile_finish(&t->file, err)) != 0)
+        return st;
+    return write_ini(e, ch, index, (faces + e->packed_width - 1) / e->packed_width, err);
+}
+
+/* Numbers are written in fixed point with a quantum of about 1e-8 of the largest coordinate:
+   finer than float32, which is how POV-Ray stores mesh vertices. */
+static void choose_number_format(povmesh_emitter *e, double largest)
+{
+    int p = (int)ceil(-log10(largest * 1e-8));
+    e->decimals = p < 0 ? 0 : p > 17 ? 17 : p;
+    e->decimal_scale = pow(10.0, e->decimals);
+    e->fixed_limit = fmin(largest * 1e3, 9e17 / e->decimal_scale);
+}
+
+static void choose_layout(povmesh_emitter *e, long long chunk_faces)
+{
+    const camera *c = e->cam;
+    const long long most = (long long)(c->crop_x1 - c->crop_x0) * (c->crop_y1 - c->crop_y0) *
+                           c->samples.spp;
+    e->packed_width = most < MAX_PACKED_WIDTH ? (int)(most > 0 ? most : 1) : MAX_PACKED_WIDTH;
+    e->chunk_faces = 0;
+    if (chunk_faces > 0) {
+        long long rows = chunk_faces / e->packed_width;
+        e->chunk_faces = (rows > 0 ? rows : 1) * e->packed_width;
+    }
+}
+
+static void free_emitter(povmesh_emitter *e)
+{
+    for (int i = 0; i < e->chunk_count; i++) {
+        discard_text(&e->chunks[i].inc);
+        outfile_discard(&e->chunks[i].ini);
+    }
+    free(e->chunks);
+    outfile_discard(&e->map);
+    if (e->has_csv)
+        discard_text(&e->csv);
+    free(e->prefix);
+    free(e);
+}
+
+static int open_side_files(povmesh_emitter *e, const char *csv_path, l2p_error *err)
+{
+    char *map_path = malloc(strlen(e->prefix) + 8);
+    if (!map_path)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    sprintf(map_path, "%s.map", e->prefix);
+    int st = outfile_open(&e->map, map_path, err);
+    free(map_path);
+    if (!st && samplemap_begin(e->map.fp) != 0)
+        st = l2p_fail(err, L2P_FAILED, e->map.final_path, 0, "write failed");
+    if (st || !csv_path)
+        return st;
+    e->has_csv = true;
+    if ((st = open_text(&e->csv, csv_path, err)) != 0)
+        return st;
+    put_str(&e->csv, "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
+                     "dir_x,dir_y,dir_z,weight\n");
+    return L2P_OK;
+}
+
+int povmesh_open(povmesh_emitter **out, const camera *c, const char *prefix, const char *csv_path,
+                 long long chunk_faces, l2p_error *err)
+{
+    povmesh_emitter *e = calloc(1, sizeof *e);
+    if (!e || !(e->prefix = strdup(prefix))) {
+        free(e);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
+    e->cam = c;
+    e->anchor_camera_mm = v3(0, 0, c->lens.surface[0].vertex_z_mm);
+    double widest = 0.0;
+    for (int i = 0; i < c->lens.count; i++)
+        widest = fmax(widest, c->lens.surface[i].aperture_mm);
+    e->triangle_size = 0.5 * widest / c->unit_mm;
+    choose_number_format(e, 4.0 * e->triangle_size);
+    choose_layout(e, chunk_faces);
+    int st = open_side_files(e, csv_path, err);
+    if (!st)
+        st = begin_chunk(e, err);
+    if (st) {
+        free_emitter(e);
+        return st;
+    }
+    *out = e;
+    return L2P_OK;
+}
+
+static int put_csv_row(povmesh_emitter *e, const emitted_ray *r, l2p_error *err)
+{
+    int st = reserve(&e->csv, 512, err);
+    if (st)
+        return st;
+    text_out *t = &e->csv;
+    t->len += (size_t)snprintf(t->buf + t->len, 512,
+        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+        r->px + r->offset_x, r->py + r->offset_y, r->film_point.x, r->film_point.y,
+        r->out.o.x, r->out.o.y, r->out.o.z, r->out.d.x, r->out.d.y, r->out.d.z, r->weight);
+    return L2P_OK;
+}
+
+int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err)
+{
+    int st;
+    chunk *ch = &e->chunks[e->chunk_count - 1];
+    if (e->chunk_faces && ch->faces == e->chunk_faces) {
+        if ((st = end_chunk(e, e->chunk_count - 1, err)) || (st = begin_chunk(e, err)))
+            return st;
+        ch = &e->chunks[e->chunk_count - 1];
+    }
+    if ((st = reserve(&ch->inc, 1024, err)) != 0)
+        return st;
+    put_ray(&ch->inc, e, &r->out);
+    ch->faces++;
+    e->faces++;
+    const samplemap_record rec = {(uint32_t)r->py * (uint32_t)e->cam->film.width + (uint32_t)r->px,
+                                  (float)r->offset_x, (float)r->offset_y, (float)r->weight};
+    if (samplemap_append(e->map.fp, &rec, 1) != 0)
+        return l2p_fail(err, L2P_FAILED, e->map.final_path, 0, "write failed");
+    return e->has_csv ? put_csv_row(e, r, err) : L2P_OK;
+}
+
+static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)
+{
+    const camera *c = e->cam;
+    memset(h, 0, sizeof *h);
+    h->film_width = c->film.width;
+    h->film_height = c->film.height;
+    h->spp = c->samples.spp;
+    h->crop_x0 = c->crop_x0;
+    h->crop_y0 = c->crop_y0;
+    h->crop_x1 = c->crop_x1;
+    h->crop_y1 = c->crop_y1;
+    h->packed_width = e->packed_width;
+    h->faces = e->faces;
+    const long long one = e->faces > 0 ? e->faces : 1;
+    h->chunk_faces = e->chunk_faces ? e->chunk_faces
+                                    : (one + e->packed_width - 1) / e->packed_width * e->packed_width;
+    snprintf(h->lens, sizeof h->lens, "%s", c->lens.name ? c->lens.name : "");
+    snprintf(h->pupil, sizeof h->pupil, "%s", pupil_kind_name(c->pupil.kind));
+    snprintf(h->trace, sizeof h->trace, "%s", c->trace == TRACE_KIND_THICK ? "thick" : "full");
+    snprintf(h->weighting, sizeof h->weighting, "%s",
+             c->weighting == WEIGHTING_PHYSICAL ? "physical" : "normalized");
+    h->f_number = c->f_number;
+    h->aperture_diameter_mm = c->lens.stop_diameter_mm;
+    h->focus_distance_units = c->focus_distance_units;
+    h->film_distance_mm = c->lens.film_distance_mm;
+    h->film_diagonal_mm = c->film.diagonal_mm;
+    h->unit_mm = c->unit_mm;
+}
+
+static int finish_all(povmesh_emitter *e, l2p_error *err)
+{
+    int st = end_chunk(e, e->chunk_count - 1, err);
+    samplemap_header h;
+    fill_map_header(e, &h);
+    if (!st && samplemap_finish(e->map.fp, &h) != 0)
+        st = l2p_fail(err, L2P_FAILED, e->map.final_path, 0, "write failed");
+    if (!st && e->has_csv && !(st = flush_text(&e->csv, err)))
+        st = outfile_finish(&e->csv.file, err);
+    if (!st)
+        st = outfile_finish(&e->map, err);
+    return st;
+}
+
+static int commit_all(povmesh_emitter *e, l2p_error *err)
+{
+    int st = L2P_OK;
+    for (int i = 0; i < e->chunk_count && !st; i++)
+        if (!(st = outfile_commit(&e->chunks[i].inc.file, err)))
+            st = outfile_commit(&e->chunks[i].ini, err);
+    if (!st && e->has_csv)
+        st = outfile_commit(&e->csv.file, err);
+    return st ? st : outfile_commit(&e->map, err);
+}
+
+static int list_chunks(const povmesh_emitter *e, povmesh_chunk_info **out, int *count)
+{
+    povmesh_chunk_info *list = calloc((size_t)e->chunk_count, sizeof *list);
+    if (!list)
+        return L2P_FAILED;
+    for (int i = 0; i < e->chunk_count; i++) {
+        list[i].include_path = chunk_path(e, i, "inc");
+        list[i].ini_path = chunk_path(e, i, "ini");
+        list[i].faces = e->chunks[i].faces;
+    }
+    *out = list;
+    *count = e->chunk_count;
+    return L2P_OK;
+}
+
+int povmesh_close(povmesh_emitter *e, bool commit, povmesh_chunk_info **chunks, int *count,
+                  l2p_error *err)
+{
+    int st = L2P_OK;
+    if (commit && !(st = finish_all(e, err)) && !(st = commit_all(e, err)) && chunks)
+        st = list_chunks(e, chunks, count) ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory") : 0;
+    free_emitter(e);
+    return st;
+}
+
+void povmesh_free_chunks(povmesh_chunk_info *chunks, int count)
+{
+    for (int i = 0; i < count; i++) {
+        free(chunks[i].include_path);
+        free(chunks[i].ini_path);
+    }
+    free(chunks);
+}

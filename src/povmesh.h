@@ -1,0 +1,51 @@
+/* Writing the ray table for POV-Ray's mesh_camera: one triangle per ray, whose centroid is the
+   ray's origin and whose normal, in POV-Ray's reversed winding, normalize((P3-P1) x (P2-P1)),
+   is its direction (see ../shared/docs/povray-mesh-camera.md). Also writes the settings
+   (.ini), the sample map (.map) and, on request, the ray table as CSV.
+
+   Layout for distribution 0 at one ray per pixel: faces fill rows of packed_width pixels.
+   POV-Ray 3.7.0.10 renders image row y with face row max(y - 1, 0) (FS#254), so every image is
+   one row taller than its face rows and its row 0 is dropped when developing. */
+#ifndef LENS2POV_POVMESH_H
+#define LENS2POV_POVMESH_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include "camera.h"
+#include "error.h"
+
+typedef struct emitted_ray {
+    int px, py;                 /* film pixel */
+    double offset_x, offset_y;  /* position in the pixel, [0, 1) */
+    vec3 film_point;            /* camera space, mm */
+    ray out;                    /* camera space, mm, origin on the lens's front */
+    double weight;
+} emitted_ray;
+
+typedef struct povmesh_chunk_info {
+    char *include_path, *ini_path;
+    long long faces;
+} povmesh_chunk_info;
+
+typedef struct povmesh_emitter povmesh_emitter;
+
+/* Opens the outputs under temporary names. chunk_faces 0: one chunk, written as PREFIX.inc and
+   PREFIX.ini; otherwise chunks of at most chunk_faces faces, PREFIX.c000.inc, PREFIX.c000.ini,
+   ... csv_path may be NULL. */
+int povmesh_open(povmesh_emitter **e, const camera *c, const char *prefix, const char *csv_path,
+                 long long chunk_faces, l2p_error *err);
+
+int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err);
+
+/* Completes every file and renames them all into place (commit), or removes them; frees e.
+   After a commit, *chunks (when not NULL) gets the chunks written, owned by the caller. */
+int povmesh_close(povmesh_emitter *e, bool commit, povmesh_chunk_info **chunks, int *count,
+                  l2p_error *err);
+
+void povmesh_free_chunks(povmesh_chunk_info *chunks, int count);
+
+/* The three vertices, relative to a reference point, of the triangle of a ray with origin o
+   and unit direction d, edge scale size: centroid o, POV-Ray normal d. Exposed for tests. */
+void povmesh_triangle(vec3 o, vec3 d, double size, vec3 v[3]);
+
+#endif

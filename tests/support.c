@@ -1,0 +1,171 @@
+#include "support.h"
+
+#include <criterion/criterion.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char **environ;
+
+const char *test_tmpdir(void)
+{
+    static char dir[64];
+    snprintf(dir, sizeof dir, "/tmp/l2ptest.XXXXXX");
+    cr_assert_not_null(mkdtemp(dir));
+    return dir;
+}
+
+const char *tmp_path(const char *dir, const char *name)
+{
+    static char buf[8][512];
+    static int next;
+    char *p = buf[next++ % 8];
+    snprintf(p, 512, "%s/%s", dir, name);
+    return p;
+}
+
+void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    cr_assert_not_null(f, "cannot write %s", path);
+    fwrite(text, 1, strlen(text), f);
+    fclose(f);
+}
+
+char *read_text(const char *path, size_t *length)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *s = malloc((size_t)n + 1);
+    size_t got = fread(s, 1, (size_t)n, f);
+    s[got] = '\0';
+    fclose(f);
+    if (length)
+        *length = got;
+    return s;
+}
+
+int run_lens2pov(char **out, char **errout, ...)
+{
+    const char *bin = getenv("LENS2POV");
+    if (!bin)
+        bin = LENS2POV_SOURCE_DIR "/build/lens2pov";
+    char *argv[64];
+    int n = 0;
+    argv[n++] = (char *)bin;
+    va_list ap;
+    va_start(ap, errout);
+    for (char *a; (a = va_arg(ap, char *)) != NULL && n < 63;)
+        argv[n++] = a;
+    va_end(ap);
+    argv[n] = NULL;
+    char dir[64];
+    snprintf(dir, sizeof dir, "/tmp/l2prun.XXXXXX");
+    cr_assert_not_null(mkdtemp(dir));
+    char o_path[128], e_path[128];
+    snprintf(o_path, sizeof o_path, "%s/out", dir);
+    snprintf(e_path, sizeof e_path, "%s/err", dir);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, o_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&fa, 2, e_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid;
+    cr_assert_eq(posix_spawn(&pid, bin, &fa, NULL, argv, environ), 0, "cannot run %s", bin);
+    posix_spawn_file_actions_destroy(&fa);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    char *o = read_text(o_path, NULL), *e = read_text(e_path, NULL);
+    unlink(o_path);
+    unlink(e_path);
+    rmdir(dir);
+    if (out) *out = o; else free(o);
+    if (errout) *errout = e; else free(e);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+csv_ray *read_rays_csv(const char *path, size_t *count)
+{
+    FILE *f = fopen(path, "r");
+    cr_assert_not_null(f, "cannot read %s", path);
+    char line[1024];
+    cr_assert_not_null(fgets(line, sizeof line, f));
+    cr_assert_str_eq(line, "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
+                           "dir_x,dir_y,dir_z,weight\n");
+    size_t n = 0, cap = 1024;
+    csv_ray *r = malloc(cap * sizeof *r);
+    while (fgets(line, sizeof line, f)) {
+        if (n == cap)
+            r = realloc(r, (cap *= 2) * sizeof *r);
+        csv_ray *x = &r[n++];
+        int k = sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x->raster_x,
+                       &x->raster_y, &x->film_x, &x->film_y, &x->o.x, &x->o.y, &x->o.z, &x->d.x,
+                       &x->d.y, &x->d.z, &x->weight);
+        cr_assert_eq(k, 11, "bad csv row: %s", line);
+    }
+    fclose(f);
+    *count = n;
+    return r;
+}
+
+/* Parses just what the emitter writes: "vertex_vectors { N," then "<x,y,z>," per vertex,
+   "face_indices { M," then "<a,b,c>," per face, then "translate <x, y, z>". */
+pov_ray *read_include_as_povray(const char *path, size_t *count)
+{
+    char *text = read_text(path, NULL);
+    cr_assert_not_null(text, "cannot read %s", path);
+    char *p = strstr(text, "vertex_vectors {");
+    cr_assert_not_null(p);
+    long nv = strtol(p + 16, &p, 10);
+    float (*v)[3] = malloc(sizeof *v * (size_t)(nv > 0 ? nv : 1));
+    for (long i = 0; i < nv; i++) {
+        p = strchr(p, '<') + 1;
+        for (int k = 0; k < 3; k++) {
+            v[i][k] = (float)strtod(p, &p);   /* POV-Ray parses a double, stores a float */
+            p++;
+        }
+    }
+    p = strstr(p, "face_indices {");
+    cr_assert_not_null(p);
+    long nf = strtol(p + 14, &p, 10);
+    pov_ray *r = malloc(sizeof *r * (size_t)(nf > 0 ? nf : 1));
+    long (*f)[3] = malloc(sizeof *f * (size_t)(nf > 0 ? nf : 1));
+    for (long i = 0; i < nf; i++) {
+        p = strchr(p, '<') + 1;
+        for (int k = 0; k < 3; k++) {
+            f[i][k] = strtol(p, &p, 10);
+            p++;
+        }
+    }
+    p = strstr(p, "translate <");
+    cr_assert_not_null(p);
+    p += 11;
+    double t[3];
+    for (int k = 0; k < 3; k++) {
+        t[k] = strtod(p, &p);
+        p++;
+    }
+    for (long i = 0; i < nf; i++) {
+        vec3 q[3];
+        for (int k = 0; k < 3; k++) {
+            const float *x = v[f[i][k]];
+            q[k] = v3(x[0], x[1], x[2]);
+        }
+        const vec3 c = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
+        r[i].o = v3_add(c, v3(t[0], t[1], t[2]));
+        r[i].d = v3_normalize(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[1], q[0])));
+    }
+    free(v);
+    free(f);
+    free(text);
+    *count = (size_t)nf;
+    return r;
+}

@@ -1,0 +1,147 @@
+/* Full simulation, surface by surface: intersections against closed forms, Snell's law,
+   and the degenerate cases (flat and near-flat surfaces, the wrong hemisphere, tangent
+   rays, total internal reflection, rays on the axis). */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <string.h>
+#include "lens.h"
+#include "support.h"
+#include "trace.h"
+
+static lens_surface sphere(double radius, double vertex_z)
+{
+    lens_surface s;
+    memset(&s, 0, sizeof s);
+    s.radius_mm = radius;
+    s.curvature_per_mm = radius == 0.0 ? 0.0 : 1.0 / radius;
+    s.vertex_z_mm = vertex_z;
+    s.aperture_mm = 1e300;
+    return s;
+}
+
+Test(trace, plane_is_hit_where_the_ray_meets_it)
+{
+    lens_surface s = sphere(0.0, 5.0);
+    ray r = {v3(1, 2, 0), v3_normalize(v3(0.3, 0, 1))};
+    vec3 n;
+    cr_assert_eq(trace_intersect(&s, &r, &n), TRACE_PASSED);
+    cr_assert_float_eq(r.o.z, 5.0, 1e-15);
+    cr_assert_float_eq(r.o.x, 1.0 + 1.5, 1e-14);
+    cr_assert(n.x == 0 && n.y == 0 && n.z == 1);
+}
+
+Test(trace, sphere_hit_matches_the_centre_form)
+{
+    /* Centre at vertex_z - R = -5; the cap near z = 5 at height 3 is z = -5 + sqrt(100 - 9). */
+    lens_surface s = sphere(10.0, 5.0);
+    ray r = {v3(0, 3, -20), v3(0, 0, 1)};
+    vec3 n;
+    cr_assert_eq(trace_intersect(&s, &r, &n), TRACE_PASSED);
+    cr_assert_float_eq(r.o.z, -5.0 + sqrt(91.0), 1e-13);
+    cr_assert_float_eq(v3_length(n), 1.0, 1e-15);
+    cr_assert_float_eq(n.y, 0.3, 1e-15, "normal = (P - centre) / R");
+}
+
+Test(trace, near_flat_surfaces_keep_their_sag)
+{
+    /* sag = -rho^2 / (2R) to first order; the centre-form quadratic would lose all of it. */
+    for (double R = 1e6; R <= 1e15; R *= 10) {
+        lens_surface s = sphere(R, 5.0);
+        ray r = {v3(0, 10, -1), v3(0, 0, 1)};
+        vec3 n;
+        cr_assert_eq(trace_intersect(&s, &r, &n), TRACE_PASSED);
+        const double sag = r.o.z - 5.0, expect = -100.0 / (2.0 * R);
+        cr_assert(fabs(sag - expect) <= 1e-15 + 1e-6 * fabs(expect), "R=%g sag=%g expect=%g", R, sag, expect);
+        cr_assert_float_eq(n.y, 10.0 / R, 1e-12 / R);
+    }
+}
+
+Test(trace, the_far_hemisphere_is_never_taken)
+{
+    /* R = 2: centre at -2, far cap near z = -4. A ray from behind crosses the far cap first;
+       the lens surface is the cap at z = -2 + sqrt(4 - 0.25). */
+    lens_surface s = sphere(2.0, 0.0);
+    ray r = {v3(0, 0.5, -10), v3(0, 0, 1)};
+    vec3 n;
+    cr_assert_eq(trace_intersect(&s, &r, &n), TRACE_PASSED);
+    cr_assert_float_eq(r.o.z, -2.0 + sqrt(3.75), 1e-14);
+    /* The same for a concave surface (R < 0) met from the scene side. */
+    lens_surface c = sphere(-2.0, 0.0);
+    ray q = {v3(0, 0.5, 10), v3(0, 0, -1)};
+    cr_assert_eq(trace_intersect(&c, &q, &n), TRACE_PASSED);
+    cr_assert_float_eq(q.o.z, 2.0 - sqrt(3.75), 1e-14);
+}
+
+Test(trace, rays_that_miss_or_graze)
+{
+    lens_surface s = sphere(2.0, 0.0);
+    vec3 n;
+    ray miss = {v3(0, 2.5, -10), v3(0, 0, 1)};
+    cr_assert_eq(trace_intersect(&s, &miss, &n), TRACE_MISSED);
+    /* Tangent at the rim of a full hemisphere: a double root, counted as a miss or met at the
+       rim, but never a non-finite number. */
+    ray tangent = {v3(0, 2.0, -10), v3(0, 0, 1)};
+    trace_status st = trace_intersect(&s, &tangent, &n);
+    cr_assert(st == TRACE_MISSED || (st == TRACE_PASSED && v3_isfinite(tangent.o) && v3_isfinite(n)));
+    /* A ray behind the surface going away from it. */
+    ray away = {v3(0, 0, 1), v3(0, 0, 1)};
+    cr_assert_eq(trace_intersect(&s, &away, &n), TRACE_MISSED);
+    /* A ray parallel to a plane. */
+    lens_surface p = sphere(0.0, 1.0);
+    ray parallel = {v3(0, 0, 0), v3(1, 0, 0)};
+    cr_assert_eq(trace_intersect(&p, &parallel, &n), TRACE_MISSED);
+}
+
+Test(trace, refraction_obeys_snell)
+{
+    const vec3 n = v3(0, 0, 1);
+    for (double deg = 0; deg < 89.5; deg += 7.3) {
+        const double a = deg * M_PI / 180.0;
+        vec3 d = v3(sin(a), 0, -cos(a));
+        cr_assert_eq(trace_refract(n, 1.0, 1.7, &d), TRACE_PASSED);
+        cr_assert_float_eq(v3_length(d), 1.0, 1e-15);
+        cr_assert_float_eq(1.7 * d.x, sin(a), 1e-15, "n1 sin i = n2 sin t at %g deg", deg);
+        cr_assert(d.z < 0, "the ray goes on through the surface");
+        vec3 e = v3(sin(a), 0, -cos(a));
+        cr_assert_eq(trace_refract(v3(0, 0, -1), 1.0, 1.7, &e), TRACE_PASSED, "either normal");
+        cr_assert_float_eq(e.x, d.x, 1e-15);
+    }
+}
+
+Test(trace, total_internal_reflection_blocks)
+{
+    /* Glass 1.5 to air: critical angle asin(1/1.5) = 41.81 degrees. */
+    const double critical = asin(1.0 / 1.5);
+    vec3 below = v3(sin(critical - 1e-6), 0, cos(critical - 1e-6));
+    vec3 above = v3(sin(critical + 1e-6), 0, cos(critical + 1e-6));
+    cr_assert_eq(trace_refract(v3(0, 0, 1), 1.5, 1.0, &below), TRACE_PASSED);
+    cr_assert(below.x > 0.999 && below.x <= 1.0, "near grazing just below the critical angle");
+    cr_assert_eq(trace_refract(v3(0, 0, 1), 1.5, 1.0, &above), TRACE_TIR);
+}
+
+Test(trace, rays_on_the_axis_stay_on_it)
+{
+    lens l;
+    l2p_error err;
+    cr_assert_eq(lens_read(LENS_DIR "dgauss.50mm.dat", &l, &err), 0, "%s", err.text);
+    lens_set_film_distance(&l, 36.77);
+    ray r = {v3(0, 0, 0), v3(0, 0, 1)};
+    cr_assert_eq(trace_toward_scene(&l, 0, l.count - 1, &r, NULL), TRACE_PASSED);
+    cr_assert(r.o.x == 0 && r.o.y == 0 && r.d.x == 0 && r.d.y == 0 && r.d.z == 1);
+    cr_assert_float_eq(r.o.z, l.surface[0].vertex_z_mm, 1e-12);
+    lens_free(&l);
+}
+
+Test(trace, apertures_clip)
+{
+    lens l;
+    l2p_error err;
+    cr_assert_eq(lens_read(LENS_DIR "dgauss.50mm.dat", &l, &err), 0, "%s", err.text);
+    lens_set_film_distance(&l, 36.77);
+    l.stop_diameter_mm = 1.0;
+    int at = -1;
+    ray r = {v3(0, 0, 0), v3_normalize(v3(0, 0.2, 1))};
+    cr_assert_eq(trace_toward_scene(&l, 0, l.count - 1, &r, &at), TRACE_CLIPPED);
+    cr_assert_eq(at, l.stop, "the small stop blocks it, not a lens element");
+    lens_free(&l);
+}

@@ -1,0 +1,127 @@
+/* Benchmarks of the tracer and the ray-table writer (figures, not tests): rays per second of
+   each trace method and pupil on each lens on one core, and bytes and time per ray of
+   writing the include. Medians of five runs. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include "camera.h"
+#include "raytable.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int by_value(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median5(double v[5])
+{
+    qsort(v, 5, sizeof v[0], by_value);
+    return v[2];
+}
+
+static int make_camera(camera *c, const char *lens_path, pupil_kind p, trace_kind t, int w, int h, int spp)
+{
+    lens l;
+    l2p_error err;
+    camera_options o;
+    camera_options_default(&o);
+    o.width = w;
+    o.height = h;
+    o.spp = spp;
+    o.pupil = p;
+    o.trace = t;
+    o.look_at = v3(0, 0, 10);
+    if (lens_read(lens_path, &l, &err) || camera_setup(c, &l, &o, &err)) {
+        fprintf(stderr, "bench: %s\n", err.text);
+        return 1;
+    }
+    return 0;
+}
+
+/* Samples of a 256 x 192 film at 16 spp: everything a film sample costs but the writing. */
+static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
+{
+    camera c;
+    if (make_camera(&c, lens_path, p, t, 256, 192, 16))
+        return;
+    double rate[5], passed_fraction = 0;
+    for (int run = 0; run < 5; run++) {
+        long long n = 0, passed = 0;
+        const double start = now();
+        for (int py = 0; py < c.film.height; py++)
+            for (int px = 0; px < c.film.width; px++)
+                for (int k = 0; k < c.samples.spp; k++) {
+                    film_sample s = sample_pattern_get(&c.samples, px, py, k);
+                    vec3 fp = film_camera_from_raster(&c.film, px + s.offset_x, py + s.offset_y);
+                    ray r;
+                    double w;
+                    passed += camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &w);
+                    n++;
+                }
+        rate[run] = (double)n / (now() - start);
+        passed_fraction = (double)passed / (double)n;
+    }
+    printf("%-22s %-11s %-6s %8.2f M samples/s  %5.1f%% pass\n", c.lens.name,
+           pupil_kind_name(p), t == TRACE_KIND_THICK ? "thick" : "full", median5(rate) / 1e6,
+           100 * passed_fraction);
+    camera_free(&c);
+}
+
+/* lens2pov trace of about 1e6 rays into dir: time and bytes per ray. */
+static void bench_write(const char *lens_path, const char *dir)
+{
+    camera c;
+    if (make_camera(&c, lens_path, PUPIL_STOP_IMAGE, TRACE_KIND_FULL, 1024, 1024, 1))
+        return;
+    char prefix[512], inc[600];
+    snprintf(prefix, sizeof prefix, "%s/bench", dir);
+    snprintf(inc, sizeof inc, "%s.inc", prefix);
+    double t[5];
+    raytable_stats st = {0, 0, 0};
+    for (int run = 0; run < 5; run++) {
+        l2p_error err;
+        if (raytable_write(&c, prefix, NULL, 0, false, NULL, NULL, &st, &err)) {
+            fprintf(stderr, "bench: %s\n", err.text);
+            return;
+        }
+        t[run] = st.seconds;
+    }
+    struct stat sb;
+    stat(inc, &sb);
+    const double m = median5(t);
+    printf("trace+write %lld rays: %.3f s median, %.0f ns/ray, %.1f bytes/ray (include %.1f MB)\n",
+           st.passed, m, 1e9 * m / (double)st.passed, (double)sb.st_size / (double)st.passed,
+           (double)sb.st_size / 1e6);
+    camera_free(&c);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: bench_trace LENS_DIR OUT_DIR\n");
+        return 2;
+    }
+    const char *lenses[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm", "telephoto.250mm"};
+    printf("== tracing, one core, 256x192 film, 16 spp, focus 10 m (median of 5)\n");
+    for (int i = 0; i < 4; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s.dat", argv[1], lenses[i]);
+        for (int p = 0; p < 3; p++)
+            bench_trace(path, (pupil_kind)p, TRACE_KIND_FULL);
+        bench_trace(path, PUPIL_STOP_IMAGE, TRACE_KIND_THICK);
+    }
+    printf("== writing the ray table (dgauss.50mm, 1024x1024, 1 spp)\n");
+    char path[512];
+    snprintf(path, sizeof path, "%s/dgauss.50mm.dat", argv[1]);
+    bench_write(path, argv[2]);
+    return 0;
+}
