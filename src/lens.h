@@ -31,6 +31,10 @@ typedef struct lens {
     double film_distance_mm; /* rear vertex to film */
 } lens;
 
+/* Limits of lens_read and lens_parse, far above any real lens: they stop a wrong file (an
+   image, a log) from taking the memory before the parser refuses it. */
+enum { LENS_MAX_FILE_BYTES = 16 * 1024 * 1024, LENS_MAX_SURFACES = 10000 };
+
 /* Reads and validates a lens file. On failure returns L2P_BAD_INPUT with "FILE:LINE: what is
    wrong" in err and leaves *out empty. The film distance starts at 0 (call
    lens_set_film_distance) and the stop at its full opening. */

@@ -10,8 +10,15 @@
 trace_status trace_intersect(const lens_surface *s, ray *r, vec3 *normal)
 {
     const double c = s->curvature_per_mm;
-    const vec3 p = v3(r->o.x, r->o.y, r->o.z - s->vertex_z_mm);
     const vec3 d = r->d;
+    vec3 p = v3(r->o.x, r->o.y, r->o.z - s->vertex_z_mm);
+    /* Spencer and Murty first carry the ray to the vertex's tangent plane: from a distant
+       origin B^2 and c C are huge and nearly equal, and their difference would cancel. */
+    double t0 = 0.0;
+    if (fabs(d.z) > 1e-6) {
+        t0 = -p.z / d.z;
+        p = v3(p.x + t0 * d.x, p.y + t0 * d.y, 0.0);
+    }
     const double B = c * v3_dot(p, d) + d.z;
     const double C = c * v3_dot(p, p) + 2.0 * p.z;
     const double disc = B * B - c * C;
@@ -21,13 +28,13 @@ trace_status trace_intersect(const lens_surface *s, ray *r, vec3 *normal)
     /* q = 0 only for a ray tangent to the surface or lying in the plane: a miss. */
     double roots[2] = {q != 0.0 ? C / q : NAN, c != 0.0 ? q / c : NAN};
     if (roots[1] < roots[0]) {
-        double t = roots[0];
+        const double t = roots[0];
         roots[0] = roots[1];
         roots[1] = t;
     }
     for (int k = 0; k < 2; k++) {
         const double t = roots[k];
-        if (!(t >= 0.0) || !isfinite(t))
+        if (!(t0 + t >= 0.0) || !isfinite(t))
             continue;
         const vec3 h = v3_madd(p, d, t);
         const double nz = 1.0 + c * h.z;   /* > 0 on the vertex-side cap */
