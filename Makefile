@@ -7,7 +7,7 @@ CXX      ?= c++
 PREFIX   ?= /usr/local
 BUILD    ?= build
 OPT      ?= -O2
-CFLAGS_BASE   = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE $(OPT) -g -Wall -Wextra -Werror
+CFLAGS_BASE   = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE $(OPT) -g -fno-math-errno -Wall -Wextra -Werror
 CXXFLAGS_BASE = -std=c++17 $(OPT) -g -Wall -Wextra -Werror
 SAN      ?=
 LDLIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util) -lstdc++ -lm -lpthread

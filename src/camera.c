@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "focus.h"
+#include "trace_batch.h"
 
 void camera_options_default(camera_options *o)
 {
@@ -223,18 +224,48 @@ static bool trace_thick(const camera *c, ray *r)
     return v3_isfinite(r->o);
 }
 
+static void soa_from_rays(trace_soa *b, const ray *r, int n)
+{
+    for (int k = 0; k < n; k++) {
+        b->ox[k] = r[k].o.x; b->oy[k] = r[k].o.y; b->oz[k] = r[k].o.z;
+        b->dx[k] = r[k].d.x; b->dy[k] = r[k].d.y; b->dz[k] = r[k].d.z;
+    }
+}
+
+static void rays_from_soa(ray *r, const trace_soa *b, int n)
+{
+    for (int k = 0; k < n; k++) {
+        r[k].o = v3(b->ox[k], b->oy[k], b->oz[k]);
+        r[k].d = v3(b->dx[k], b->dy[k], b->dz[k]);
+    }
+}
+
+void camera_trace_batch(const camera *c, const vec3 *film_points, const double *u,
+                        const double *v, int n, ray *out, double *weight, bool *passed)
+{
+    trace_soa b;
+    for (int k = 0; k < n; k++) {
+        out[k].o = film_points[k];
+        weight[k] = pupil_film_ray(&c->pupil, film_points[k], u[k], v[k], &out[k].d) * c->weight_scale;
+        b.status[k] = weight[k] > 0.0 && isfinite(weight[k]) && v3_isfinite(out[k].d)
+                          ? TRACE_PASSED : TRACE_MISSED;
+    }
+    if (c->trace == TRACE_KIND_THICK) {
+        for (int k = 0; k < n; k++)
+            if (b.status[k] == TRACE_PASSED && !trace_thick(c, &out[k]))
+                b.status[k] = TRACE_MISSED;
+    } else {
+        soa_from_rays(&b, out, n);
+        trace_soa_toward_scene(&c->lens, &b, n);
+        rays_from_soa(out, &b, n);
+    }
+    for (int k = 0; k < n; k++)
+        passed[k] = b.status[k] == TRACE_PASSED && v3_isfinite(out[k].o) && v3_isfinite(out[k].d);
+}
+
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight)
 {
-    ray r = {film_point, v3(0, 0, 1)};
-    const double w = pupil_film_ray(&c->pupil, film_point, u, v, &r.d);
-    if (!(w > 0.0) || !v3_isfinite(r.d))
-        return false;
-    bool passed = c->trace == TRACE_KIND_THICK
-                      ? trace_thick(c, &r)
-                      : trace_toward_scene(&c->lens, 0, c->lens.count - 1, &r, NULL) == TRACE_PASSED;
-    if (!passed || !v3_isfinite(r.o) || !v3_isfinite(r.d))
-        return false;
-    *out = r;
-    *weight = w * c->weight_scale;
-    return isfinite(*weight);
+    bool passed;
+    camera_trace_batch(c, &film_point, &u, &v, 1, out, weight, &passed);
+    return passed;
 }

@@ -60,6 +60,11 @@ void camera_free(camera *c);
    weight, and returns true; false when the lens blocks it. */
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight);
 
+/* The same for n <= CAMERA_BATCH samples at once, interleaved for speed. */
+enum { CAMERA_BATCH = 64 };   /* = TRACE_SOA_MAX */
+void camera_trace_batch(const camera *c, const vec3 *film_points, const double *u,
+                        const double *v, int n, ray *out, double *weight, bool *passed);
+
 vec3 camera_world_from_camera_point(const camera *c, vec3 p);
 vec3 camera_world_from_camera_dir(const camera *c, vec3 d);
 

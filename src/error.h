@@ -4,6 +4,10 @@
 
 #include <stddef.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Exit statuses of the contract: 2 bad usage or bad input, 1 anything else. */
 enum { L2P_OK = 0, L2P_FAILED = 1, L2P_BAD_INPUT = 2 };
 
@@ -16,5 +20,9 @@ typedef struct l2p_error {
    status, so that callers can write `return l2p_fail(err, ...)`. */
 int l2p_fail(l2p_error *err, int status, const char *file, int line, const char *fmt, ...)
     __attribute__((format(printf, 5, 6)));
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

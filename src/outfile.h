@@ -8,6 +8,10 @@
 #include <sys/types.h>
 #include "error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct outfile {
     FILE *fp;
     char *final_path;
@@ -37,5 +41,9 @@ void outfile_untrack(const char *temp_path);
 /* Child processes to terminate (SIGTERM, then wait) before the handler removes the files. */
 void outfile_track_child(pid_t pid);
 void outfile_untrack_child(pid_t pid);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -54,18 +54,28 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
     if (make_camera(&c, lens_path, p, t, 256, 192, 16))
         return;
     double rate[5], passed_fraction = 0;
+    vec3 fp[CAMERA_BATCH];
+    double u[CAMERA_BATCH], v[CAMERA_BATCH], w[CAMERA_BATCH];
+    ray r[CAMERA_BATCH];
+    bool ok[CAMERA_BATCH];
     for (int run = 0; run < 5; run++) {
         long long n = 0, passed = 0;
+        int b = 0;
         const double start = now();
         for (int py = 0; py < c.film.height; py++)
             for (int px = 0; px < c.film.width; px++)
                 for (int k = 0; k < c.samples.spp; k++) {
                     film_sample s = sample_pattern_get(&c.samples, px, py, k);
-                    vec3 fp = film_camera_from_raster(&c.film, px + s.offset_x, py + s.offset_y);
-                    ray r;
-                    double w;
-                    passed += camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &w);
-                    n++;
+                    fp[b] = film_camera_from_raster(&c.film, px + s.offset_x, py + s.offset_y);
+                    u[b] = s.pupil_u;
+                    v[b] = s.pupil_v;
+                    if (++b < CAMERA_BATCH)
+                        continue;
+                    camera_trace_batch(&c, fp, u, v, b, r, w, ok);
+                    for (int j = 0; j < b; j++)
+                        passed += ok[j];
+                    n += b;
+                    b = 0;
                 }
         rate[run] = (double)n / (now() - start);
         passed_fraction = (double)passed / (double)n;

@@ -1,0 +1,748 @@
+/* Running POV-Ray 3.7 on the chunks of a ray table. What each step relies on was found by
+   experiment; see ../pov/README.md. */
+#include "povray.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include "outfile.h"
+#include "progress.h"
+
+enum {
+    TOKENS_PER_FACE = 26,      /* POV-Ray's "Parsing NK tokens" per mesh2 face, measured */
+    PROGRESS_TAIL = 256,       /* bytes of a log read for the latest status line */
+    ERROR_TAIL = 65536,        /* bytes of a failed log searched for POV-Ray's messages */
+    TICK_MS = 50,
+    DRAW_EVERY_TICKS = 5,      /* redraw the bar 4 times a second */
+    STOP_WAIT_TICKS = 100      /* SIGTERM, then 5 s, then SIGKILL */
+};
+
+/* ---------------------------------------------------------------- small strings and paths */
+
+static char *str_printf(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static char *str_printf(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    const int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (s) {
+        va_start(ap, fmt);
+        vsnprintf(s, (size_t)n + 1, fmt, ap);
+        va_end(ap);
+    }
+    return s;
+}
+
+/* The child runs in the scene's folder, so every path it gets must be absolute. */
+static char *absolute_path(const char *path)
+{
+    if (path[0] == '/')
+        return strdup(path);
+    char cwd[4096];
+    if (!getcwd(cwd, sizeof cwd))
+        return NULL;
+    return str_printf("%s/%s", cwd, path);
+}
+
+static char *folder_of(const char *abs_path)
+{
+    char *d = strdup(abs_path);
+    char *slash = d ? strrchr(d, '/') : NULL;
+    if (slash)
+        slash[slash == d ? 1 : 0] = '\0';
+    return d;
+}
+
+/* POV-Ray 3.7 reads paths (options and SDL strings alike) as ASCII: other bytes become
+   spaces, and a '"' cannot be quoted. Backslashes are escapes in SDL strings. */
+static bool povray_can_read(const char *path)
+{
+    for (const unsigned char *p = (const unsigned char *)path; *p; p++)
+        if (*p < 0x20 || *p > 0x7e || *p == '"' || *p == '\\')
+            return false;
+    return true;
+}
+
+/* ---------------------------------------------------------------- the run's shared state */
+
+typedef struct path_link {
+    char *link, *target;       /* a symlink we made in work_dir, for error messages */
+} path_link;
+
+typedef struct job {
+    pid_t pid;                 /* 0: slot free */
+    int chunk;
+    char *log_path;
+    double parse_fraction, render_fraction;
+} job;
+
+typedef struct run {
+    const povray_chunk *chunks;
+    int count;
+    const povray_options *opts;
+    char *exe;
+    char *work_dir;
+    char *scene_real_dir;      /* the child's working folder */
+    char *scene_for_povray, *scene_dir_for_povray;
+    path_link *links;
+    int link_count;
+    job *jobs;
+    int job_slots;
+    progress bar;
+} run;
+
+static void free_run(run *r)
+{
+    free(r->exe);
+    free(r->work_dir);
+    free(r->scene_real_dir);
+    free(r->scene_for_povray);
+    free(r->scene_dir_for_povray);
+    for (int i = 0; i < r->link_count; i++) {
+        free(r->links[i].link);
+        free(r->links[i].target);
+    }
+    free(r->links);
+    for (int i = 0; r->jobs && i < r->job_slots; i++)
+        free(r->jobs[i].log_path);
+    free(r->jobs);
+}
+
+static int out_of_memory(l2p_error *err)
+{
+    return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+}
+
+/* A path POV-Ray can read: abs_path itself, or a symlink named name in work_dir. */
+static int readable_for_povray(run *r, const char *abs_path, const char *name, char **out,
+                               l2p_error *err)
+{
+    if (povray_can_read(abs_path))
+        return (*out = strdup(abs_path)) ? L2P_OK : out_of_memory(err);
+    path_link *grown = realloc(r->links, (size_t)(r->link_count + 1) * sizeof *grown);
+    if (!grown)
+        return out_of_memory(err);
+    r->links = grown;
+    path_link *l = &r->links[r->link_count];
+    l->link = str_printf("%s/%s", r->work_dir, name);
+    l->target = strdup(abs_path);
+    if (!l->link || !l->target) {
+        free(l->link);
+        free(l->target);
+        return out_of_memory(err);
+    }
+    r->link_count++;
+    unlink(l->link);
+    if (symlink(abs_path, l->link) != 0)
+        return l2p_fail(err, L2P_FAILED, l->link, 0, "cannot make a link: %s", strerror(errno));
+    return (*out = strdup(l->link)) ? L2P_OK : out_of_memory(err);
+}
+
+/* Paths POV-Ray writes to or that lens2pov chose itself cannot be linked around. */
+static int check_plain(const char *path, l2p_error *err)
+{
+    if (povray_can_read(path))
+        return L2P_OK;
+    return l2p_fail(err, L2P_FAILED, path, 0,
+                    "POV-Ray 3.7 cannot use this path (only plain ASCII without '\"' or '\\')");
+}
+
+/* ---------------------------------------------------------------- setting up */
+
+static bool is_executable_file(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode) && access(path, X_OK) == 0;
+}
+
+/* The executable's absolute path (the child changes folder before execv). */
+static int find_povray(run *r, l2p_error *err)
+{
+    const char *name = r->opts->povray;
+    if (!name || !*name)
+        name = getenv("LENS2POV_POVRAY");
+    if (!name || !*name)
+        name = "povray";
+    if (strchr(name, '/')) {
+        if (is_executable_file(name))
+            return (r->exe = absolute_path(name)) ? L2P_OK : out_of_memory(err);
+    } else {
+        const char *path = getenv("PATH");
+        char *dirs = strdup(path && *path ? path : "/usr/local/bin:/usr/bin:/bin");
+        if (!dirs)
+            return out_of_memory(err);
+        char *save = NULL;
+        for (char *d = strtok_r(dirs, ":", &save); d && !r->exe; d = strtok_r(NULL, ":", &save)) {
+            char *candidate = str_printf("%s/%s", *d ? d : ".", name);
+            if (candidate && is_executable_file(candidate))
+                r->exe = absolute_path(candidate);
+            free(candidate);
+        }
+        free(dirs);
+        if (r->exe)
+            return L2P_OK;
+    }
+    return l2p_fail(err, L2P_FAILED, NULL, 0, "%s: not found (install Debian's povray package)",
+                    name);
+}
+
+/* The scene must exist (bad input otherwise); POV-Ray gets it and its folder, linked when
+   their paths are not plain ASCII, and runs in that folder like `povray scene.pov` there. */
+static int prepare_scene(run *r, l2p_error *err)
+{
+    const char *scene = r->opts->scene_path;
+    if (access(scene, R_OK) != 0)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
+    char *abs_scene = absolute_path(scene);
+    r->scene_real_dir = abs_scene ? folder_of(abs_scene) : NULL;
+    int st = r->scene_real_dir ? L2P_OK : out_of_memory(err);
+    if (!st)
+        st = readable_for_povray(r, abs_scene, "povray.scene.pov", &r->scene_for_povray, err);
+    if (!st)
+        st = readable_for_povray(r, r->scene_real_dir, "povray.scene-folder",
+                                 &r->scene_dir_for_povray, err);
+    free(abs_scene);
+    return st;
+}
+
+static int prepare_run(run *r, const povray_chunk *chunks, int count, const povray_options *opts,
+                       l2p_error *err)
+{
+    memset(r, 0, sizeof *r);
+    r->chunks = chunks;
+    r->count = count;
+    r->opts = opts;
+    r->job_slots = opts->jobs > 0 ? opts->jobs : 1;
+    if (r->job_slots > count)
+        r->job_slots = count;
+    r->jobs = calloc((size_t)r->job_slots, sizeof *r->jobs);
+    r->work_dir = absolute_path(opts->work_dir);
+    if (!r->jobs || !r->work_dir)
+        return out_of_memory(err);
+    int st = check_plain(r->work_dir, err);
+    if (!st)
+        st = prepare_scene(r, err);
+    if (!st)
+        st = find_povray(r, err);
+    return st;
+}
+
+/* ---------------------------------------------------------------- one chunk's files */
+
+/* The wrapper: the scene first, then the camera, so that the lens camera replaces the
+   scene's own. Nothing about #version or gamma here: the camera include raises the language
+   version only when it is below 3.7 and restores it (an unversioned scene must stay one). */
+static int write_wrapper(const char *path, const char *scene, const char *include, int index,
+                         l2p_error *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    fprintf(f,
+            "// lens2pov: the scene seen through chunk %d of the lens camera. The camera is\n"
+            "// declared after the scene, so it replaces the scene's own camera.\n"
+            "#include \"%s\"\n#include \"%s\"\n", index, scene, include);
+    const bool bad = ferror(f) != 0;
+    if (fclose(f) != 0 || bad)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    return L2P_OK;
+}
+
+typedef struct chunk_args {
+    char *wrapper, *ini, *output;
+} chunk_args;
+
+static void free_chunk_args(chunk_args *a)
+{
+    free(a->wrapper);
+    free(a->ini);
+    free(a->output);
+}
+
+static int prepare_chunk(run *r, int index, chunk_args *a, l2p_error *err)
+{
+    const povray_chunk *c = &r->chunks[index];
+    memset(a, 0, sizeof *a);
+    char *include = absolute_path(c->include_path), *ini = absolute_path(c->ini_path);
+    char *inc_name = str_printf("povray.c%03d.inc", index);
+    char *ini_name = str_printf("povray.c%03d.ini", index);
+    char *pov_inc = NULL;
+    a->wrapper = str_printf("%s/povray.c%03d.pov", r->work_dir, index);
+    a->output = absolute_path(c->output_exr);
+    int st = include && ini && inc_name && ini_name && a->wrapper && a->output
+                 ? L2P_OK : out_of_memory(err);
+    if (!st && (access(include, R_OK) != 0 || access(ini, R_OK) != 0))
+        st = l2p_fail(err, L2P_FAILED, access(include, R_OK) ? include : ini, 0,
+                      "cannot read: %s", strerror(errno));
+    if (!st)
+        st = check_plain(a->output, err);
+    if (!st)
+        st = readable_for_povray(r, include, inc_name, &pov_inc, err);
+    if (!st)
+        st = readable_for_povray(r, ini, ini_name, &a->ini, err);
+    if (!st)
+        st = write_wrapper(a->wrapper, r->scene_for_povray, pov_inc, index, err);
+    free(include);
+    free(ini);
+    free(inc_name);
+    free(ini_name);
+    free(pov_inc);
+    return st;
+}
+
+/* ---------------------------------------------------------------- processes */
+
+/* The command line. Options after the chunk's ini override it and any povray.ini: no display,
+   no pause, no continuing an old render, no alpha (it zeroes the background), no
+   antialiasing (it mixes neighbouring rays), +V for the progress lines, -GS -GR for no
+   statistics, EXR, and Display_Gamma=sRGB, which sets how a scene without gamma handling
+   is decoded into the linear EXR. Paths are quoted for spaces. */
+static char **povray_argv(const run *r, const chunk_args *a)
+{
+    enum { ARGS = 20 };
+    char **argv = calloc(ARGS, sizeof *argv);
+    if (!argv)
+        return NULL;
+    int n = 0;
+    argv[n++] = strdup(r->exe);
+    argv[n++] = str_printf("\"%s\"", a->ini);
+    argv[n++] = str_printf("+I\"%s\"", a->wrapper);
+    argv[n++] = str_printf("+O\"%s\"", a->output);
+    argv[n++] = str_printf("+L\"%s\"", r->scene_dir_for_povray);
+    const char *fixed[] = {"-D", "-P", "-C", "-UA", "-A", "+V", "-GS", "-GR", "+FE",
+                           "Display_Gamma=sRGB"};
+    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
+        argv[n++] = strdup(fixed[i]);
+    if (r->opts->threads_per_job > 0)
+        argv[n++] = str_printf("+WT%d", r->opts->threads_per_job);
+    for (int i = 0; i < n; i++)
+        if (!argv[i]) {
+            for (int k = 0; k < n; k++)
+                free(argv[k]);
+            free(argv);
+            return NULL;
+        }
+    return argv;
+}
+
+static void free_argv(char **argv)
+{
+    for (int i = 0; argv && argv[i]; i++)
+        free(argv[i]);
+    free(argv);
+}
+
+static void write_text(int fd, const char *a, const char *b)
+{
+    if (write(fd, a, strlen(a)) < 0 || write(fd, b, strlen(b)) < 0 || write(fd, "\n", 1) < 0)
+        return;
+}
+
+/* In the child: default signal handling (ours would remove the run's files), stdin from
+   /dev/null, stdout and stderr into the log, the scene's folder as working folder. Only
+   async-signal-safe calls: the parent may have threads. */
+static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *old_mask)
+{
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    signal(SIGHUP, SIG_DFL);
+    sigprocmask(SIG_SETMASK, old_mask, NULL);
+    const int null_fd = open("/dev/null", O_RDONLY);
+    if (null_fd >= 0)
+        dup2(null_fd, STDIN_FILENO);
+    dup2(log_fd, STDOUT_FILENO);
+    dup2(log_fd, STDERR_FILENO);
+    if (chdir(r->scene_real_dir) != 0) {
+        write_text(STDERR_FILENO, "lens2pov: cannot enter the scene's folder ", r->scene_real_dir);
+    } else {
+        execv(argv[0], argv);
+        write_text(STDERR_FILENO, "lens2pov: cannot run ", argv[0]);
+    }
+    _exit(127);
+}
+
+/* Forks with the cleanup signals blocked, so that the child is registered for the signal
+   handler before any signal can be handled. */
+static pid_t spawn(const run *r, char **argv, int log_fd)
+{
+    sigset_t block, old;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigaddset(&block, SIGHUP);
+    sigprocmask(SIG_BLOCK, &block, &old);
+    const pid_t pid = fork();
+    if (pid == 0)
+        exec_child(r, argv, log_fd, &old);
+    if (pid > 0)
+        outfile_track_child(pid);
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    return pid;
+}
+
+static int start_job(run *r, job *j, int index, l2p_error *err)
+{
+    chunk_args a;
+    int st = prepare_chunk(r, index, &a, err);
+    char **argv = st ? NULL : povray_argv(r, &a);
+    free(j->log_path);
+    j->log_path = str_printf("%s/povray.c%03d.log", r->work_dir, index);
+    if (!st && (!argv || !j->log_path))
+        st = out_of_memory(err);
+    const int fd = st ? -1 : open(j->log_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (!st && fd < 0)
+        st = l2p_fail(err, L2P_FAILED, j->log_path, 0, "cannot write: %s", strerror(errno));
+    if (!st) {
+        j->pid = spawn(r, argv, fd);
+        if (j->pid < 0) {
+            j->pid = 0;
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
+        }
+        j->chunk = index;
+        j->parse_fraction = j->render_fraction = 0;
+    }
+    if (fd >= 0)
+        close(fd);
+    free_argv(argv);
+    free_chunk_args(&a);
+    return st;
+}
+
+static void sleep_ms(int ms)
+{
+    const struct timespec t = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&t, NULL);
+}
+
+/* Stops every running job: SIGTERM, up to 5 s, then SIGKILL; reaps all of them. */
+static void stop_jobs(run *r)
+{
+    for (int i = 0; i < r->job_slots; i++)
+        if (r->jobs[i].pid)
+            kill(r->jobs[i].pid, SIGTERM);
+    for (int tick = 0;; tick++) {
+        int running = 0;
+        for (int i = 0; i < r->job_slots; i++) {
+            job *j = &r->jobs[i];
+            if (!j->pid)
+                continue;
+            if (tick == STOP_WAIT_TICKS)
+                kill(j->pid, SIGKILL);
+            const pid_t w = waitpid(j->pid, NULL, tick >= STOP_WAIT_TICKS ? 0 : WNOHANG);
+            if (w == j->pid || (w < 0 && errno == ECHILD)) {
+                outfile_untrack_child(j->pid);
+                j->pid = 0;
+            } else {
+                running++;
+            }
+        }
+        if (!running)
+            return;
+        sleep_ms(TICK_MS);
+    }
+}
+
+/* ---------------------------------------------------------------- POV-Ray's messages */
+
+/* The last `len` bytes of a file (at most), NUL-terminated; NULL if unreadable. */
+static char *read_tail(const char *path, long len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    const long size = ftell(f);
+    const long from = size > len ? size - len : 0;
+    fseek(f, from, SEEK_SET);
+    char *s = malloc((size_t)(size - from) + 1);
+    const size_t got = s ? fread(s, 1, (size_t)(size - from), f) : 0;
+    if (s)
+        s[got] = '\0';
+    fclose(f);
+    return s;
+}
+
+/* One message: POV-Ray wraps long messages onto lines that start with one space. */
+typedef struct message {
+    char file[1024];
+    int line;
+    int rank;                  /* 3 Parse Error, 2 Possible Parse Error, 1 other text, 0 noise */
+    bool section;              /* a "==== [Parsing...] ====" line */
+    char text[512];
+} message;
+
+static bool starts_with(const char *s, const char *prefix)
+{
+    return strncmp(s, prefix, strlen(prefix)) == 0;
+}
+
+/* Progress, banners, warnings and endings carry no reason for a failure. */
+static bool is_noise(const char *s)
+{
+    static const char *const prefixes[] = {"====", "Rendered ", "Parsing ", "Render failed",
+                                           "Render cancelled", "POV-Ray finished",
+                                           "Fatal error in parser:",
+                                           "povray: cannot open the user configuration file"};
+    for (size_t i = 0; i < sizeof prefixes / sizeof prefixes[0]; i++)
+        if (starts_with(s, prefixes[i]))
+            return true;
+    return !*s || strstr(s, "Warning:") || strstr(s, "assumed_gamma not specified");
+}
+
+/* Splits "File 'F' line N: Kind: text" into its parts and ranks it. */
+static void classify(message *m, const char *s)
+{
+    memset(m, 0, sizeof *m);
+    const char *rest = s, *q;
+    int line;
+    if (starts_with(s, "File '") && (q = strstr(s + 6, "' line ")) &&
+        sscanf(q, "' line %d", &line) == 1 && strchr(q, ':')) {
+        snprintf(m->file, sizeof m->file, "%.*s", (int)(q - (s + 6)), s + 6);
+        m->line = line;
+        rest = strchr(q, ':') + 1;
+        while (*rest == ' ')
+            rest++;
+    }
+    if (starts_with(rest, "Parse Error:"))
+        m->rank = 3, rest += strlen("Parse Error:");
+    else if (starts_with(rest, "Possible Parse Error:"))
+        m->rank = 2, rest += strlen("Possible Parse Error:");
+    else
+        m->rank = is_noise(s) ? 0 : 1;
+    while (*rest == ' ')
+        rest++;
+    m->section = starts_with(s, "====");
+    snprintf(m->text, sizeof m->text, "%.*s", (int)sizeof m->text - 1, rest);
+    const size_t n = strlen(m->text);
+    if (n && m->text[n - 1] == '.')
+        m->text[n - 1] = '\0';
+}
+
+/* Splits the log into messages (joining continuation lines); returns how many. */
+static int split_messages(char *log, message *out, int max)
+{
+    int count = 0;
+    char joined[1536] = "";
+    char *save = NULL;
+    for (char *ln = strtok_r(log, "\r\n", &save);; ln = strtok_r(NULL, "\r\n", &save)) {
+        if (ln && ln[0] == ' ' && ln[1] != ' ' && joined[0]) {
+            const size_t n = strlen(joined);
+            snprintf(joined + n, sizeof joined - n, "%s", ln);
+            continue;
+        }
+        if (joined[0]) {
+            if (count == max) {
+                memmove(out, out + 1, (size_t)(max - 1) * sizeof *out);
+                count--;
+            }
+            classify(&out[count++], joined);
+        }
+        if (!ln)
+            return count;
+        snprintf(joined, sizeof joined, "%s", ln);
+    }
+}
+
+/* A path in POV-Ray's words, with our symlinks turned back into the user's paths. POV-Ray
+   names a file as the scene wrote it: a relative name was found in its working folder, the
+   scene's folder, when it is there. */
+static void unlink_name(const run *r, const char *file, char *out, size_t size)
+{
+    if (file[0] != '/') {
+        char *in_scene_dir = str_printf("%s/%s", r->scene_real_dir, file);
+        const bool there = in_scene_dir && access(in_scene_dir, F_OK) == 0;
+        snprintf(out, size, "%s", there ? in_scene_dir : file);
+        free(in_scene_dir);
+        return;
+    }
+    for (int i = 0; i < r->link_count; i++) {
+        const size_t n = strlen(r->links[i].link);
+        if (strncmp(file, r->links[i].link, n) == 0 && (file[n] == '\0' || file[n] == '/')) {
+            snprintf(out, size, "%s%s", r->links[i].target, file + n);
+            return;
+        }
+    }
+    snprintf(out, size, "%s", file);
+}
+
+/* The message that says why: the last Parse Error, else the last Possible Parse Error or
+   other text (only text after POV-Ray's first section line: before it is the banner); -1 if
+   none. "Fatal error in parser" is only the consequence of an earlier message. */
+static int telling_message(const message *m, int n)
+{
+    int first_section = -1, best = -1;
+    for (int i = 0; i < n && first_section < 0; i++)
+        if (m[i].section)
+            first_section = i;
+    for (int i = 0; i < n; i++) {
+        const bool counts = m[i].rank >= 2 || (m[i].rank == 1 && i > first_section);
+        if (counts && (best < 0 || m[best].rank < 3 || m[i].rank == 3))
+            best = i;
+    }
+    return best;
+}
+
+/* Reports m[best] as FILE:LINE: text, joined with the other errors at the same place. */
+static int report_messages(const run *r, const message *m, int n, l2p_error *err)
+{
+    const int best = telling_message(m, n);
+    if (best < 0)
+        return 0;
+    char text[900] = "";
+    for (int i = 0; i < n; i++) {
+        const bool same = i == best || (m[best].rank >= 2 && m[i].rank >= 2 &&
+                                         m[i].line == m[best].line &&
+                                         strcmp(m[i].file, m[best].file) == 0);
+        if (!same || (i > 0 && m[i - 1].rank >= 2 && strcmp(m[i].text, m[i - 1].text) == 0))
+            continue;
+        const size_t len = strlen(text);
+        snprintf(text + len, sizeof text - len, "%s%s", len ? "; " : "", m[i].text);
+    }
+    if (!m[best].file[0])
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: %s", text);
+    char file[1024];
+    unlink_name(r, m[best].file, file, sizeof file);
+    return l2p_fail(err, L2P_FAILED, file, m[best].line, "%s", text);
+}
+
+/* Why a job failed, in POV-Ray's own words when its log has them. */
+static int explain_failure(const run *r, const job *j, int status, l2p_error *err)
+{
+    enum { MAX_MESSAGES = 64 };
+    char *log = read_tail(j->log_path, ERROR_TAIL);
+    message *m = calloc(MAX_MESSAGES, sizeof *m);
+    const int n = log && m ? split_messages(log, m, MAX_MESSAGES) : 0;
+    int st = report_messages(r, m, n, err);
+    free(m);
+    free(log);
+    if (st)
+        return st;
+    if (WIFSIGNALED(status))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: killed by signal %d (log: %s)",
+                        WTERMSIG(status), j->log_path);
+    return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: failed with status %d (log: %s)",
+                    WIFEXITED(status) ? WEXITSTATUS(status) : -1, j->log_path);
+}
+
+/* A finished job: success needs exit status 0 and the EXR on disk. */
+static int check_finished(const run *r, const job *j, int status, l2p_error *err)
+{
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        return explain_failure(r, j, status, err);
+    const char *out = r->chunks[j->chunk].output_exr;
+    if (access(out, R_OK) != 0)
+        return l2p_fail(err, L2P_FAILED, out, 0, "POV-Ray finished without writing it (log: %s)",
+                        j->log_path);
+    return L2P_OK;
+}
+
+/* ---------------------------------------------------------------- progress */
+
+/* The latest "Parsing NK tokens" or "Rendered N of M pixels" in the log's tail. The parse
+   share is estimated from the chunk's face count. */
+static void read_job_progress(const run *r, job *j)
+{
+    char *tail = read_tail(j->log_path, PROGRESS_TAIL);
+    if (!tail)
+        return;
+    long long a, b;
+    const long long faces = r->chunks[j->chunk].faces;
+    for (char *p = tail; (p = strstr(p, "Rendered ")) != NULL; p++)
+        if (sscanf(p, "Rendered %lld of %lld", &a, &b) == 2 && b > 0) {
+            j->parse_fraction = 1;
+            j->render_fraction = (double)a / (double)b;
+        }
+    for (char *p = tail; j->render_fraction == 0 && (p = strstr(p, "Parsing ")) != NULL; p++)
+        if (sscanf(p, "Parsing %lldK tokens", &a) == 1 && faces > 0)
+            j->parse_fraction = (double)a * 1000.0 / ((double)faces * TOKENS_PER_FACE);
+    if (j->parse_fraction > 1)
+        j->parse_fraction = 1;
+    free(tail);
+}
+
+static void draw_progress(run *r, int finished)
+{
+    if (!r->bar.enabled)
+        return;
+    double sum = finished;
+    int running = 0;
+    for (int i = 0; i < r->job_slots; i++)
+        if (r->jobs[i].pid) {
+            read_job_progress(r, &r->jobs[i]);
+            sum += 0.5 * r->jobs[i].parse_fraction + 0.5 * r->jobs[i].render_fraction;
+            running++;
+        }
+    char detail[64];
+    snprintf(detail, sizeof detail, "%d of %d chunks done, %d running", finished, r->count,
+             running);
+    progress_update(&r->bar, sum / r->count, detail);
+}
+
+/* ---------------------------------------------------------------- the scheduler */
+
+/* Reaps the jobs that ended; returns how many did, and the first failure in *st. */
+static int reap_jobs(run *r, int *st, l2p_error *err)
+{
+    int ended = 0;
+    for (int i = 0; i < r->job_slots; i++) {
+        job *j = &r->jobs[i];
+        int status;
+        if (!j->pid || waitpid(j->pid, &status, WNOHANG) != j->pid)
+            continue;
+        outfile_untrack_child(j->pid);
+        j->pid = 0;
+        ended++;
+        if (!*st)
+            *st = check_finished(r, j, status, err);
+    }
+    return ended;
+}
+
+static int schedule(run *r, l2p_error *err)
+{
+    int next = 0, finished = 0, st = L2P_OK;
+    for (int tick = 0; !st && finished < r->count; tick++) {
+        for (int i = 0; i < r->job_slots && next < r->count && !st; i++)
+            if (!r->jobs[i].pid)
+                st = start_job(r, &r->jobs[i], next++, err);
+        const int ended = st ? 0 : reap_jobs(r, &st, err);
+        finished += ended;
+        if (ended || st)
+            continue;  /* start the next chunks at once */
+        if (tick % DRAW_EVERY_TICKS == 0)
+            draw_progress(r, finished);
+        sleep_ms(TICK_MS);
+    }
+    if (!st)
+        draw_progress(r, finished);
+    stop_jobs(r);  /* only a failed run has any left */
+    return st;
+}
+
+int povray_render_chunks(const povray_chunk *chunks, int count, const povray_options *opts,
+                         l2p_error *err)
+{
+    if (count <= 0)
+        return L2P_OK;
+    run r;
+    int st = prepare_run(&r, chunks, count, opts, err);
+    if (!st) {
+        progress_start(&r.bar, "POV-Ray", opts->show_progress);
+        st = schedule(&r, err);
+        progress_finish(&r.bar);
+    }
+    free_run(&r);
+    return st;
+}

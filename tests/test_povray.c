@@ -1,0 +1,373 @@
+/* Running the real POV-Ray through src/povray.c on a hand-written mesh_camera include: a 4x2
+   ray table (one triangle per ray: origin = centroid, direction = normalize((P3-P1) x (P2-P1)),
+   rendered 4x3 because of the row bug FS#254), the gamma of old and new scenes, POV-Ray's
+   own error lines, chunks in parallel and stopping them on a failure. */
+#include <criterion/criterion.h>
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "povray.h"
+
+/* ---------------------------------------------------------------- files */
+
+static char *fmt(const char *f, const char *a, const char *b)
+{
+    char *s = malloc(4096);
+    snprintf(s, 4096, f, a, b);
+    return s;
+}
+
+static void put_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    cr_assert_not_null(f, "cannot write %s", path);
+    fputs(text, f);
+    fclose(f);
+}
+
+static char *new_dir(void)
+{
+    char *d = strdup("/tmp/l2p_povray.XXXXXX");
+    cr_assert_not_null(mkdtemp(d));
+    return d;
+}
+
+/* A 4x2 ray table, every ray from z = -3 along dz (+1 or -1), origins 1 cm apart; the
+   include raises the language version only when it is below 3.7, as lens2pov's does. */
+static void write_include(const char *path, int dz)
+{
+    FILE *f = fopen(path, "w");
+    cr_assert_not_null(f);
+    fputs("#if (version < 3.7)\n  #declare Lens2pov_Version = version;\n  #version 3.7;\n#end\n"
+          "#declare Lens2pov_Rays = mesh2 {\n  vertex_vectors { 24,\n", f);
+    const double e = 1e-3;
+    for (int k = 0; k < 8; k++) {
+        const double x = 0.01 * (k % 4), y = -0.01 * (k / 4);
+        /* P1, P2 = P1 + e y, P3 = P1 + e x: (P3-P1) x (P2-P1) = e^2 z; reversed for -z. */
+        const double dy = dz > 0 ? e : 0, dx = dz > 0 ? 0 : e;
+        fprintf(f, "<%g,%g,0>,<%g,%g,0>,<%g,%g,0>,\n", x, y, x + dx, y + dy, x + dy, y + dx);
+    }
+    fputs("  }\n  face_indices { 8,\n", f);
+    for (int k = 0; k < 8; k++)
+        fprintf(f, "<%d,%d,%d>,\n", 3 * k, 3 * k + 1, 3 * k + 2);
+    fputs("  }\n}\ncamera { mesh_camera { 1 0 mesh { Lens2pov_Rays translate <0,0,-3> } } }\n"
+          "#undef Lens2pov_Rays\n"
+          "#ifdef (Lens2pov_Version)\n  #version Lens2pov_Version;\n  #undef Lens2pov_Version\n"
+          "#end\n", f);
+    fclose(f);
+}
+
+/* Width 4, one row more than the two face rows (FS#254), EXR. */
+static void write_ini(const char *path, const char *exr)
+{
+    char *text = fmt("Width=4\nHeight=3\nAntialias=Off\nOutput_File_Type=E\n"
+                     "Output_To_File=On\nOutput_File_Name=%s\nDisplay=Off\n%s", exr, "");
+    put_file(path, text);
+    free(text);
+}
+
+typedef struct fixture {
+    char *dir;
+    povray_chunk chunk[2];
+    char *paths[6];
+} fixture;
+
+/* Chunk i: dir/rays.c00i.{inc,ini,exr}, rays along dz[i]. */
+static void make_chunks(fixture *fx, const char *dir, int count, const int *dz)
+{
+    memset(fx, 0, sizeof *fx);
+    fx->dir = strdup(dir);
+    for (int i = 0; i < count; i++) {
+        char name[64];
+        snprintf(name, sizeof name, "rays.c%03d", i);
+        char *inc = fmt("%s/%s.inc", dir, name), *ini = fmt("%s/%s.ini", dir, name);
+        char *exr = fmt("%s/%s.exr", dir, name);
+        write_include(inc, dz[i]);
+        write_ini(ini, exr);
+        fx->chunk[i] = (povray_chunk){inc, ini, exr, 8};
+        fx->paths[3 * i] = inc, fx->paths[3 * i + 1] = ini, fx->paths[3 * i + 2] = exr;
+    }
+}
+
+static void free_fixture(fixture *fx)
+{
+    for (int i = 0; i < 6; i++)
+        free(fx->paths[i]);
+    free(fx->dir);
+}
+
+static povray_options options(const char *scene, const char *work_dir, int jobs)
+{
+    return (povray_options){scene, work_dir, jobs, 1, 0, NULL};
+}
+
+/* ---------------------------------------------------------------- reading the EXR back */
+
+/* The 4x3 pixels' RGB, read with oiiotool (the tests link no C++). */
+static void read_exr(const char *path, float rgb[12][3])
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "oiiotool --dumpdata '%s' 2>&1", path);
+    FILE *p = popen(cmd, "r");
+    cr_assert_not_null(p);
+    char line[512];
+    int seen = 0;
+    while (fgets(line, sizeof line, p)) {
+        int x, y;
+        float r, g, b;
+        if (sscanf(line, " Pixel (%d, %d): %f %f %f", &x, &y, &r, &g, &b) == 5 && x < 4 && y < 3) {
+            rgb[y * 4 + x][0] = r, rgb[y * 4 + x][1] = g, rgb[y * 4 + x][2] = b;
+            seen++;
+        }
+    }
+    cr_assert_eq(pclose(p), 0, "oiiotool failed on %s", path);
+    cr_assert_eq(seen, 12, "%s: %d pixels", path, seen);
+}
+
+static void expect_uniform(const char *exr, float r, float g, float b)
+{
+    float rgb[12][3];
+    read_exr(exr, rgb);
+    for (int i = 0; i < 12; i++)
+        cr_expect(fabsf(rgb[i][0] - r) < 1e-3f && fabsf(rgb[i][1] - g) < 1e-3f &&
+                      fabsf(rgb[i][2] - b) < 1e-3f,
+                  "%s pixel %d: %g %g %g, expected %g %g %g", exr, i, rgb[i][0], rgb[i][1],
+                  rgb[i][2], r, g, b);
+}
+
+/* ---------------------------------------------------------------- scenes */
+
+/* A glowing plane at z = 0 in front of the rays, and a camera of the scene's own looking the
+   other way (it would see black): the lens camera, declared later, must win. */
+static const char MODERN_SCENE[] =
+    "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0,0,-3> look_at <0,0,-10> }\n"
+    "plane { -z, 0 pigment { rgb <0.25,0.5,0.75> } finish { ambient 1 diffuse 0 } }\n";
+
+Test(povray, renders_a_modern_scene_through_the_lens_camera, .timeout = 20)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
+    put_file(scene, MODERN_SCENE);
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    expect_uniform(fx.chunk[0].output_exr, 0.25f, 0.5f, 0.75f);
+    free_fixture(&fx);
+    free(scene);
+    free(dir);
+}
+
+/* No #version and no assumed_gamma: POV-Ray's own PNG shows the raw 0.25 (64), so the EXR
+   must hold sRGB-decoded 0.0509. A povray.ini in the scene's folder (it replaces the system
+   one) with another display gamma, alpha and antialiasing must not change that. */
+Test(povray, an_old_scene_keeps_its_gamma_and_povray_ini_cannot_change_it, .timeout = 20)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "old.pov"), *ini = fmt("%s/%s", dir, "povray.ini");
+    put_file(scene, "background { rgb 0.25 }\n");
+    put_file(ini, "Display_Gamma=1.0\nOutput_Alpha=On\nAntialias=On\n");
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    const float v = powf((0.25f + 0.055f) / 1.055f, 2.4f);
+    expect_uniform(fx.chunk[0].output_exr, v, v, v);
+    free_fixture(&fx);
+    free(scene);
+    free(ini);
+    free(dir);
+}
+
+/* The scene's own includes resolve from its folder, the standard ones from POV-Ray's. */
+Test(povray, includes_resolve_from_the_scene_folder_and_the_library, .timeout = 20)
+{
+    char *dir = new_dir(), *sub = fmt("%s/%s", dir, "scenes");
+    mkdir(sub, 0777);
+    char *scene = fmt("%s/%s", sub, "s.pov"), *mine = fmt("%s/%s", sub, "mine.inc");
+    put_file(mine, "#declare MyColour = rgb <0.5, 0.25, 0>;\n");
+    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n#include \"colors.inc\"\n"
+                    "#include \"mine.inc\"\nbackground { MyColour }\n");
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    expect_uniform(fx.chunk[0].output_exr, 0.5f, 0.25f, 0.0f);
+    free_fixture(&fx);
+    free(scene);
+    free(mine);
+    free(sub);
+    free(dir);
+}
+
+/* A folder and file name POV-Ray cannot read (a space is fine, é is not): it gets links. */
+Test(povray, scene_paths_that_are_not_ascii_work_and_errors_name_them, .timeout = 20)
+{
+    char *dir = new_dir(), *sub = fmt("%s/%s", dir, "sc\xc3\xa8ne 1");
+    mkdir(sub, 0777);
+    char *scene = fmt("%s/%s", sub, "\xc3\xa9t\xc3\xa9.pov"), *mine = fmt("%s/%s", sub, "mine.inc");
+    put_file(mine, "#declare MyColour = rgb 0.5;\n");
+    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                    "#include \"mine.inc\"\nbackground { MyColour }\n");
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    expect_uniform(fx.chunk[0].output_exr, 0.5f, 0.5f, 0.5f);
+
+    put_file(mine, "#declare MyColour = rgb 0.5;\nsphere { 0, 1 pigment { foo } }\n");
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
+    char *expected = fmt("%s:%s: ", mine, "2");
+    cr_expect(strncmp(err.text, expected, strlen(expected)) == 0, "%s", err.text);
+    free(expected);
+    free_fixture(&fx);
+    free(scene);
+    free(mine);
+    free(sub);
+    free(dir);
+}
+
+/* POV-Ray's parse error comes back as FILE:LINE: message, nothing else from its log. */
+Test(povray, a_syntax_error_names_the_file_and_line, .timeout = 20)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "bad.pov");
+    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                    "sphere { <0,0,0>, 1 pigment { rgb 1 }\nbox { 0, 1 }\n");
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
+    cr_assert_eq(err.status, L2P_FAILED);
+    char *expected = fmt("%s:4: No matching } in 'sphere', box found instead%s", scene, "");
+    cr_expect_str_eq(err.text, expected);
+    free(expected);
+    free_fixture(&fx);
+    free(scene);
+    free(dir);
+}
+
+Test(povray, a_missing_image_file_is_named, .timeout = 20)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "img.pov");
+    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n\n"
+                    "plane { z, 1 pigment { image_map { png \"nofile.png\" } } }\n");
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
+    char *expected = fmt("%s:4: %s", scene, "Cannot find file 'nofile.png'");
+    cr_expect(strncmp(err.text, expected, strlen(expected)) == 0, "%s", err.text);
+    free(expected);
+    free_fixture(&fx);
+    free(scene);
+    free(dir);
+}
+
+Test(povray, a_missing_scene_is_bad_input, .timeout = 10)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "none.pov");
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_BAD_INPUT);
+    cr_expect(strstr(err.text, scene) && strstr(err.text, "No such file"), "%s", err.text);
+    cr_expect(access(fx.chunk[0].output_exr, F_OK) != 0);
+    free_fixture(&fx);
+    free(scene);
+    free(dir);
+}
+
+Test(povray, a_missing_povray_says_which_package, .timeout = 10)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
+    put_file(scene, MODERN_SCENE);
+    fixture fx;
+    make_chunks(&fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    o.povray = "no-such-povray-here";
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
+    cr_expect_str_eq(err.text, "no-such-povray-here: not found (install Debian's povray package)");
+    free_fixture(&fx);
+    free(scene);
+    free(dir);
+}
+
+/* Two chunks at once, the second looking back at another plane. POV-Ray runs behind a
+   script that waits until both have started: run one after the other, the first gives up. */
+Test(povray, two_chunks_render_in_parallel, .timeout = 20)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
+    char *script = fmt("%s/%s", dir, "barrier"), *marks = fmt("%s/%s", dir, "started");
+    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                    "plane { -z, 0 pigment { rgb <1,0,0> } finish { ambient 1 diffuse 0 } }\n"
+                    "plane { z, -10 pigment { rgb <0,1,0> } finish { ambient 1 diffuse 0 } }\n");
+    char *text = fmt("#!/bin/sh\ntouch '%s'.$$\nn=0\n"
+                     "while [ $(ls '%s'.* | wc -l) -lt 2 ]; do\n"
+                     "  n=$((n+1)); [ $n -lt 100 ] || { echo 'not in parallel' >&2; exit 1; }\n"
+                     "  sleep 0.05\ndone\nexec povray \"$@\"\n", marks, marks);
+    put_file(script, text);
+    free(text);
+    chmod(script, 0755);
+    fixture fx;
+    make_chunks(&fx, dir, 2, (const int[]){1, -1});
+    povray_options o = options(scene, dir, 2);
+    o.povray = script;
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 2, &o, &err), L2P_OK, "%s", err.text);
+    expect_uniform(fx.chunk[0].output_exr, 1, 0, 0);
+    expect_uniform(fx.chunk[1].output_exr, 0, 1, 0);
+    free_fixture(&fx);
+    free(scene);
+    free(script);
+    free(marks);
+    free(dir);
+}
+
+/* A failing chunk stops the other one (a stand-in for POV-Ray that would sleep for a minute):
+   the call returns at once, the sleeper is gone and nothing is left to reap. */
+Test(povray, a_failure_stops_the_other_processes, .timeout = 20)
+{
+    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
+    char *script = fmt("%s/%s", dir, "fakepov"), *pidfile = fmt("%s/%s", dir, "sleeper.pid");
+    put_file(scene, MODERN_SCENE);
+    char *text = fmt("#!/bin/sh\ncase \"$*\" in\n*c001*) echo $$ > '%s'; exec sleep 60;;\n"
+                     "*) while [ ! -s '%s' ]; do sleep 0.05; done\n"
+                     "   echo \"File '/x/y.pov' line 7: Parse Error: broken\" >&2; exit 1;;\nesac\n",
+                     pidfile, pidfile);
+    put_file(script, text);
+    free(text);
+    chmod(script, 0755);
+    fixture fx;
+    make_chunks(&fx, dir, 2, (const int[]){1, 1});
+    povray_options o = options(scene, dir, 2);
+    o.povray = script;
+    /* The failing chunk waits until the sleeper has written its pid. */
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_chunks(fx.chunk, 2, &o, &err), L2P_FAILED);
+    cr_expect_str_eq(err.text, "/x/y.pov:7: broken");
+    FILE *f = fopen(pidfile, "r");
+    cr_assert_not_null(f, "the sleeper never started");
+    int pid = 0;
+    cr_expect_eq(fscanf(f, "%d", &pid), 1);
+    fclose(f);
+    cr_expect(pid > 0 && kill(pid, 0) != 0 && errno == ESRCH, "sleeper %d still there", pid);
+    cr_expect(waitpid(-1, NULL, WNOHANG) < 0 && errno == ECHILD, "a child is left");
+    free_fixture(&fx);
+    free(scene);
+    free(script);
+    free(pidfile);
+    free(dir);
+}
