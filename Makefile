@@ -21,7 +21,8 @@ LIB_OBJ = $(LIB_C:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/obj/%.o
 TEST_C  = $(wildcard tests/*.c)
 TEST_OBJ = $(TEST_C:tests/%.c=$(BUILD)/tobj/%.o)
 
-.PHONY: all deps test test-unit test-sanitize bench demo gallery report stability fuzz install clean
+.PHONY: all deps test test-unit test-sanitize test-extra bench demo gallery report stability fuzz \
+        valgrind install clean
 
 all: $(BUILD)/lens2pov
 
@@ -56,6 +57,11 @@ test-unit: $(BUILD)/lens2pov $(BUILD)/run_tests
 test: deps
 	$(MAKE) test-unit
 	$(MAKE) test-sanitize
+	$(MAKE) test-extra
+
+# Checks beyond the Criterion suite: a short fuzz run of the lens reader and the option parser,
+# and valgrind over one trace.
+test-extra: fuzz valgrind
 
 # The same suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its own build folder.
 test-sanitize: deps
@@ -71,6 +77,21 @@ $(BUILD)/bench_trace: tools/bench_trace.c $(BUILD)/liblens2pov.a
 
 demo: deps $(BUILD)/lens2pov
 	sh tools/demo.sh $(BUILD)/lens2pov
+
+gallery: deps $(BUILD)/lens2pov
+	sh examples/render-all-lenses.sh pov/scene.pov out/gallery
+
+report: deps $(BUILD)/lens2pov
+	sh tools/report.sh $(BUILD)
+
+stability: deps $(BUILD)/lens2pov
+	sh tools/stability.sh $(BUILD)
+
+fuzz: deps
+	sh tests/fuzz/run.sh
+
+valgrind: deps $(BUILD)/lens2pov
+	sh tools/valgrind.sh $(BUILD)/lens2pov
 
 install: $(BUILD)/lens2pov
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/lens2pov/lenses $(DESTDIR)$(PREFIX)/share/lens2pov/pov
