@@ -157,9 +157,10 @@ static int begin_chunk(povmesh_emitter *e, l2p_error *err)
     if (st)
         return st;
     text_out *t = &ch->inc;
-    t->len += (size_t)snprintf(t->buf, 256,
+    t->len += (size_t)snprintf(t->buf, 1024,
         "// lens2pov ray table: one triangle per ray for mesh_camera (distribution 0).\n"
-        "#declare Lens2pov_Version = version;\n#version 3.7;\n"
+        "// mesh_camera needs 3.7; an older scene keeps its own version (and gamma) after it.\n"
+        "#if (version < 3.7)\n  #declare Lens2pov_Version = version;\n  #version 3.7;\n#end\n"
         "#declare Lens2pov_Rays = mesh2 {\n  vertex_vectors {");
     ch->count_offset = (long)t->len;
     t->len += (size_t)snprintf(t->buf + t->len, 64, "%*s,\n", COUNT_FIELD, "");
@@ -226,7 +227,9 @@ static void put_camera(text_out *t, const povmesh_emitter *e)
     t->len += (size_t)snprintf(t->buf + t->len, 512,
         "  }\n}\ncamera {\n  mesh_camera {\n    1 0\n"
         "    mesh { Lens2pov_Rays translate <%.17g, %.17g, %.17g> }\n  }\n}\n"
-        "#undef Lens2pov_Rays\n#version Lens2pov_Version;\n", w.x, w.y, w.z);
+        "#undef Lens2pov_Rays\n"
+        "#ifdef (Lens2pov_Version)\n  #version Lens2pov_Version;\n  #undef Lens2pov_Version\n#end\n",
+        w.x, w.y, w.z);
 }
 
 static int write_ini(povmesh_emitter *e, chunk *ch, int index, long long rows, l2p_error *err)

@@ -19,7 +19,7 @@
 #include "progress.h"
 
 enum {
-    TOKENS_PER_FACE = 26,      /* POV-Ray's "Parsing NK tokens" per mesh2 face, measured */
+    TOKENS_PER_FACE = 29,      /* "Parsing NK tokens" per face of a lens2pov ray table, measured */
     PROGRESS_TAIL = 256,       /* bytes of a log read for the latest status line */
     ERROR_TAIL = 65536,        /* bytes of a failed log searched for POV-Ray's messages */
     TICK_MS = 50,
@@ -288,6 +288,8 @@ static int prepare_chunk(run *r, int index, chunk_args *a, l2p_error *err)
                       "cannot read: %s", strerror(errno));
     if (!st)
         st = check_plain(a->output, err);
+    if (!st)
+        unlink(a->output);  /* a stale EXR must not pass for this run's */
     if (!st)
         st = readable_for_povray(r, include, inc_name, &pov_inc, err);
     if (!st)

@@ -121,7 +121,9 @@ static int render_chunks(const cli *c, const workspace *w, const povmesh_chunk_i
         if (!exrs[i])
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
-    const povray_options po = {c->positional[0], w->dir, jobs, 0, !c->quiet, NULL};
+    /* Each process gets its share of the cores: POV-Ray alone would take them all. */
+    const int threads = number_of_cores() / jobs > 1 ? number_of_cores() / jobs : 1;
+    const povray_options po = {c->positional[0], w->dir, jobs, threads, !c->quiet, NULL};
     if (!st)
         st = povray_render_chunks(pc, count, &po, err);
     char map_path[8192];

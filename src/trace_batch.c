@@ -1,69 +1,192 @@
-/* The full simulation for many rays at once, in structure-of-arrays form and without branches
-   inside the loop over rays: one ray's work is a long chain of divisions and square roots, and
-   only independent rays side by side keep the processor busy. Same formulas, in the same
-   order, as trace_kernel.h (tests/test_trace.c checks they agree bit for bit). */
+/* The full simulation for many rays at once, in structure-of-arrays form: one ray's work is a
+   long chain of divisions and square roots, and only independent rays side by side keep the
+   processor busy. Same formulas, in the same order, as trace_kernel.h (tests/test_trace.c
+   checks that the two agree bit for bit). */
 #include "trace_batch.h"
 
 #include <float.h>
+#include <math.h>
+#include <string.h>
 
-static inline double dmax(double a, double b) { return a > b ? a : b; }
+/* The same threshold as trace_kernel.h. */
+#define TRANSFER_RADII 4
 
-/* Valid root: ahead of the ray (counting the transfer t0), finite, and on the vertex cap.
-   Bitwise & rather than &&: no branches, so the loop vectorizes. */
-static inline long long root_ok(double t0, double t, double pz, double dz, double c)
+/* Eight rays a step as four SSE2 pairs (SSE2 is part of every x86-64). Each helper below
+   issues one instruction per pair, so the four pairs' chains of divisions and square roots
+   interleave and the processor overlaps them: one ray at a time, a surface is a chain of
+   some 200 cycles. The operations and their order are those of trace_kernel.h, so the
+   results agree bit for bit. */
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#define PAIRS 4
+#define LANES (2 * PAIRS)
+typedef struct vd { __m128d p[PAIRS]; } vd;
+
+#define UNROLL _Pragma("GCC unroll 4")
+#define BINARY(name, op)                                                                  \
+    static inline vd name(vd a, vd b)                                                     \
+    {                                                                                     \
+        vd r;                                                                             \
+        UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = op(a.p[i], b.p[i]);               \
+        return r;                                                                         \
+    }
+BINARY(add, _mm_add_pd)
+BINARY(sub, _mm_sub_pd)
+BINARY(mul, _mm_mul_pd)
+BINARY(dvd, _mm_div_pd)
+BINARY(and, _mm_and_pd)
+BINARY(or, _mm_or_pd)
+BINARY(andnot, _mm_andnot_pd)
+BINARY(lt, _mm_cmplt_pd)
+BINARY(le, _mm_cmple_pd)
+BINARY(gt, _mm_cmpgt_pd)
+BINARY(ge, _mm_cmpge_pd)
+BINARY(ne, _mm_cmpneq_pd)
+BINARY(vmax, _mm_max_pd)
+
+static inline vd splat(double x)
 {
-    return (t0 + t >= 0) & (fabs(t) <= DBL_MAX) & (1 + c * (pz + t * dz) >= 0);
+    vd r;
+    UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = _mm_set1_pd(x);
+    return r;
+}
+
+static inline vd vsqrt(vd a)
+{
+    vd r;
+    UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = _mm_sqrt_pd(a.p[i]);
+    return r;
+}
+
+static inline vd load(const double *x)
+{
+    vd r;
+    UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = _mm_loadu_pd(x + 2 * i);
+    return r;
+}
+
+static inline void store(double *x, vd v)
+{
+    UNROLL for (int i = 0; i < PAIRS; i++) _mm_storeu_pd(x + 2 * i, v.p[i]);
+}
+
+static inline int bits(vd mask)
+{
+    int r = 0;
+    UNROLL for (int i = 0; i < PAIRS; i++) r |= _mm_movemask_pd(mask.p[i]) << (2 * i);
+    return r;
+}
+
+static inline vd pick(vd mask, vd a, vd b) { return or(and(mask, a), andnot(mask, b)); }
+static inline vd neg(vd x) { return sub(splat(0), x); }
+static inline vd vabs(vd x) { return andnot(splat(-0.0), x); }
+static inline vd vcopysign(vd x, vd y) { return or(andnot(splat(-0.0), x), and(splat(-0.0), y)); }
+static inline vd dot(vd ax, vd ay, vd az, vd bx, vd by, vd bz)
+{
+    return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
+}
+
+static inline vd root_ok(vd t0, vd t, vd pz, vd dz, vd c)
+{
+    const vd ahead = ge(add(t0, t), splat(0));
+    const vd finite = le(vabs(t), splat(DBL_MAX));
+    const vd cap = ge(add(splat(1), mul(c, add(pz, mul(t, dz)))), splat(0));
+    return and(and(ahead, finite), cap);
+}
+
+/* Status per lane: missed, clipped, totally reflected, or still passing; returns the mask of
+   lanes still passing. */
+static vd update_status(long long *status, int hit, int inside, int tir)
+{
+    double ok[LANES];
+    for (int i = 0; i < LANES; i++) {
+        if (status[i] == TRACE_PASSED)
+            status[i] = !(hit >> i & 1) ? TRACE_MISSED : !(inside >> i & 1) ? TRACE_CLIPPED
+                      : (tir >> i & 1) ? TRACE_TIR : TRACE_PASSED;
+        const long long m = status[i] == TRACE_PASSED ? -1 : 0;
+        memcpy(&ok[i], &m, sizeof m);
+    }
+    return load(ok);
+}
+
+/* The intersection: the point h on the vertex-side cap and whether there is one. */
+static inline vd intersect(const lens_surface *s, const vd o[3], const vd d[3], vd h[3])
+{
+    const double cs = s->curvature_per_mm;
+    const vd c = splat(cs), zero = splat(0);
+    const vd pz0 = sub(o[2], splat(s->vertex_z_mm));
+    const vd transfer = and(gt(vabs(d[2]), splat(1e-6)), gt(vabs(mul(c, pz0)), splat(TRANSFER_RADII)));
+    vd t0 = zero, px = o[0], py = o[1], pz = pz0;
+    if (bits(transfer)) {
+        t0 = pick(transfer, dvd(neg(pz0), d[2]), zero);
+        px = add(px, mul(t0, d[0]));
+        py = add(py, mul(t0, d[1]));
+        pz = pick(transfer, zero, pz0);
+    }
+    const vd B = add(mul(c, dot(px, py, pz, d[0], d[1], d[2])), d[2]);
+    const vd C = add(mul(c, dot(px, py, pz, px, py, pz)), mul(splat(2), pz));
+    const vd disc = sub(mul(B, B), mul(c, C));
+    const vd q = neg(add(B, vcopysign(vsqrt(vmax(disc, zero)), B)));
+    const vd near = pick(ne(q, zero), dvd(C, q), splat(NAN));
+    const vd far = mul(q, splat(cs != 0 ? s->radius_mm : NAN));
+    const vd swap = lt(far, near);
+    const vd lo = pick(swap, far, near), hi = pick(swap, near, far);
+    const vd lo_ok = root_ok(t0, lo, pz, d[2], c), hi_ok = root_ok(t0, hi, pz, d[2], c);
+    const vd t = pick(lo_ok, lo, hi);
+    h[0] = add(px, mul(t, d[0]));
+    h[1] = add(py, mul(t, d[1]));
+    h[2] = add(pz, mul(t, d[2]));
+    return and(ge(disc, zero), or(lo_ok, hi_ok));
+}
+
+static void cross_lanes(const lens_surface *s, double a2, double eta_s, double *o_at[3],
+                        double *d_at[3], long long *status)
+{
+    const vd c = splat(s->curvature_per_mm), eta = splat(eta_s), one = splat(1);
+    vd o[3], d[3], h[3];
+    for (int j = 0; j < 3; j++) {
+        o[j] = load(o_at[j]);
+        d[j] = load(d_at[j]);
+    }
+    const vd hit = intersect(s, o, d, h);
+    /* Refraction at the normal (c hx, c hy, 1 + c hz), oriented against the ray. */
+    const vd nx0 = mul(c, h[0]), ny0 = mul(c, h[1]), nz0 = add(one, mul(c, h[2]));
+    const vd cos_i0 = neg(dot(nx0, ny0, nz0, d[0], d[1], d[2]));
+    const vd flip = pick(lt(cos_i0, splat(0)), splat(-1), one);
+    const vd nx = mul(nx0, flip), ny = mul(ny0, flip), nz = mul(nz0, flip), cos_i = mul(cos_i0, flip);
+    const vd sin2_t = mul(mul(eta, eta), sub(one, mul(cos_i, cos_i)));
+    const vd kk = sub(mul(eta, cos_i), vsqrt(vmax(sub(one, sin2_t), splat(0))));
+    const int refracts = eta_s != 1;
+    const vd ok = update_status(status, bits(hit), bits(le(add(mul(h[0], h[0]), mul(h[1], h[1])), splat(a2))),
+                                refracts ? bits(gt(sin2_t, one)) : 0);
+    store(o_at[0], pick(ok, h[0], o[0]));
+    store(o_at[1], pick(ok, h[1], o[1]));
+    store(o_at[2], pick(ok, add(h[2], splat(s->vertex_z_mm)), o[2]));
+    if (refracts) {
+        store(d_at[0], pick(ok, add(mul(eta, d[0]), mul(kk, nx)), d[0]));
+        store(d_at[1], pick(ok, add(mul(eta, d[1]), mul(kk, ny)), d[1]));
+        store(d_at[2], pick(ok, add(mul(eta, d[2]), mul(kk, nz)), d[2]));
+    }
 }
 
 static void cross_surface(const lens *l, int i, double eta, trace_soa *b, int n)
 {
-    const lens_surface *s = &l->surface[i];
-    const double c = s->curvature_per_mm, R = s->radius_mm, zv = s->vertex_z_mm;
-    const double a = lens_semi_aperture_mm(l, i), a2 = a * a;
-    const double far_scale = c != 0 ? R : NAN;
-    const long long refracts = eta != 1;
-    for (int k = 0; k < n; k++) {
-        const double dx = b->dx[k], dy = b->dy[k], dz = b->dz[k];
-        const long long transfer = fabs(dz) > 1e-6;
-        const double pz0 = b->oz[k] - zv;
-        const double t0 = transfer ? -pz0 / dz : 0;
-        const double px = b->ox[k] + t0 * dx, py = b->oy[k] + t0 * dy, pz = transfer ? 0 : pz0;
-        const double B = c * (px * dx + py * dy + pz * dz) + dz;
-        const double C = c * (px * px + py * py + pz * pz) + 2 * pz;
-        const double disc = B * B - c * C;
-        const double q = -(B + copysign(sqrt(dmax(disc, 0)), B));
-        const double near = q != 0 ? C / q : NAN, far = q * far_scale;
-        const double lo = far < near ? far : near, hi = far < near ? near : far;
-        const long long lo_ok = root_ok(t0, lo, pz, dz, c), hi_ok = root_ok(t0, hi, pz, dz, c);
-        const double t = lo_ok ? lo : hi;
-        const double hx = px + t * dx, hy = py + t * dy, hz = pz + t * dz;
-        const long long hit = (disc >= 0) & (lo_ok | hi_ok);
-        const long long inside = hx * hx + hy * hy <= a2;
-        /* Refraction at the normal (c hx, c hy, 1 + c hz), oriented against the ray. */
-        const double nx0 = c * hx, ny0 = c * hy, nz0 = 1 + c * hz;
-        const double cos_i0 = -(nx0 * dx + ny0 * dy + nz0 * dz);
-        const double flip = cos_i0 < 0 ? -1 : 1;
-        const double nx = nx0 * flip, ny = ny0 * flip, nz = nz0 * flip, cos_i = cos_i0 * flip;
-        const double sin2_t = eta * eta * (1 - cos_i * cos_i);
-        const double cos_t = sqrt(dmax(1 - sin2_t, 0));
-        const double kk = eta * cos_i - cos_t;
-        const long long tir = refracts & (sin2_t > 1);
-        const long long alive = b->status[k] == TRACE_PASSED;
-        const long long ok = alive & hit & inside & !tir;
-        const long long why = !hit ? TRACE_MISSED : !inside ? TRACE_CLIPPED : tir ? TRACE_TIR : TRACE_PASSED;
-        b->status[k] = alive ? why : b->status[k];
-        const long long bend = ok & refracts;
-        b->ox[k] = ok ? hx : b->ox[k];
-        b->oy[k] = ok ? hy : b->oy[k];
-        b->oz[k] = ok ? hz + zv : b->oz[k];
-        b->dx[k] = bend ? eta * dx + kk * nx : dx;
-        b->dy[k] = bend ? eta * dy + kk * ny : dy;
-        b->dz[k] = bend ? eta * dz + kk * nz : dz;
+    const double a = lens_semi_aperture_mm(l, i);
+    for (int k = 0; k < n; k += LANES) {
+        double *o[3] = {b->ox + k, b->oy + k, b->oz + k}, *d[3] = {b->dx + k, b->dy + k, b->dz + k};
+        cross_lanes(&l->surface[i], a * a, eta, o, d, b->status + k);
     }
 }
+#endif
 
 void trace_soa_toward_scene(const lens *l, trace_soa *b, int n)
 {
+#if defined(__SSE2__)
+    for (int k = n; k % LANES; k++) {   /* dead, finite rays pad the last step */
+        b->ox[k] = b->oy[k] = b->oz[k] = b->dx[k] = b->dy[k] = 0;
+        b->dz[k] = 1;
+        b->status[k] = TRACE_MISSED;
+    }
     for (int i = l->count - 1; i >= 0; i--)
         cross_surface(l, i, lens_ior_behind(l, i) / lens_ior_front(l, i), b, n);
     for (int k = 0; k < n; k++) {
@@ -72,4 +195,15 @@ void trace_soa_toward_scene(const lens *l, trace_soa *b, int n)
         b->dy[k] *= inv;
         b->dz[k] *= inv;
     }
+#else
+    /* Elsewhere, the one-ray kernel, one ray after the other. */
+    for (int k = 0; k < n; k++) {
+        if (b->status[k] != TRACE_PASSED)
+            continue;
+        ray r = {v3(b->ox[k], b->oy[k], b->oz[k]), v3(b->dx[k], b->dy[k], b->dz[k])};
+        b->status[k] = trace_toward_scene(l, 0, l->count - 1, &r, NULL);
+        b->ox[k] = r.o.x; b->oy[k] = r.o.y; b->oz[k] = r.o.z;
+        b->dx[k] = r.d.x; b->dy[k] = r.d.y; b->dz[k] = r.d.z;
+    }
+#endif
 }

@@ -7,10 +7,12 @@
 
 enum { TRACE_SOA_MAX = 64 };
 
+/* Room past TRACE_SOA_MAX: a count that is not a multiple of the vector width is padded. */
+
 typedef struct trace_soa {
-    double ox[TRACE_SOA_MAX], oy[TRACE_SOA_MAX], oz[TRACE_SOA_MAX];
-    double dx[TRACE_SOA_MAX], dy[TRACE_SOA_MAX], dz[TRACE_SOA_MAX];
-    long long status[TRACE_SOA_MAX];   /* a trace_status, as wide as a double for vector code;
+    double ox[TRACE_SOA_MAX + 8], oy[TRACE_SOA_MAX + 8], oz[TRACE_SOA_MAX + 8];
+    double dx[TRACE_SOA_MAX + 8], dy[TRACE_SOA_MAX + 8], dz[TRACE_SOA_MAX + 8];
+    long long status[TRACE_SOA_MAX + 8];   /* a trace_status, as wide as a double for vector code;
                                           TRACE_PASSED on entry for the rays to trace */
 } trace_soa;
 

@@ -19,18 +19,30 @@ static inline KVEC KNAME(madd)(KVEC a, KVEC b, KREAL s)
 /* In local coordinates (x, y, s = z - vertex_z) a surface of curvature c, whose centre lies at
    s = -1/c, is F = c (x^2 + y^2 + s^2) + 2 s = 0; c = 0 is the plane s = 0. Along p + t d
    (|d| = 1): c t^2 + 2 B t + C = 0 with B = c (p.d) + d_z and C = c |p|^2 + 2 s0.
-   Spencer and Murty (JOSA 52, 1962) first carry the ray to the vertex's tangent plane (from a
-   distant origin B^2 and c C would be huge and nearly equal), then take the root that tends
+   Spencer and Murty (JOSA 52, 1962) first carry the ray to the vertex's tangent plane: from an
+   origin n radii away B^2 and c C agree to about 1/n^2 and their difference loses log10(n^2)
+   digits. Rays from the neighbouring surface lose none worth a division, so the transfer is
+   made only from more than TRANSFER_RADII radii away. Then they take the root that tends
    to the vertex as t = -C / (B + sgn(B) sqrt(B^2 - c C)), which loses no digits as c -> 0;
    the other root is -(B + sgn(B) sqrt(B^2 - c C)) / c. The unit normal is (c x, c y, 1 + c s);
    its z component is positive on the cap that holds the vertex, the only part the lens has. */
+/* Beyond this many radii from the vertex plane a ray is carried to it first (error <= 16 ulp). */
+#ifndef TRANSFER_RADII
+#define TRANSFER_RADII 4
+#endif
+
+static inline int KNAME(needs_transfer)(KREAL c, KREAL pz, KREAL dz)
+{
+    return fabs(dz) > (KREAL)1e-6 && fabs(c * pz) > TRANSFER_RADII;
+}
+
 static inline __attribute__((always_inline)) trace_status KNAME(intersect)(const lens_surface *s, KRAY *r, KVEC *normal)
 {
     const KREAL c = s->curvature_per_mm;
     const KVEC d = r->d;
     KVEC p = {r->o.x, r->o.y, r->o.z - (KREAL)s->vertex_z_mm};
     KREAL t0 = 0;
-    if (fabs(d.z) > (KREAL)1e-6) {
+    if (KNAME(needs_transfer)(c, p.z, d.z)) {
         t0 = -p.z / d.z;
         p.x += t0 * d.x;
         p.y += t0 * d.y;

@@ -27,7 +27,7 @@ static csv_ray *trace_csv(const char *dir, const char *lens_name, const char *pu
     return read_rays_csv(csv, n);
 }
 
-Test(emit, include_reproduces_the_traced_rays, .timeout = 60)
+Test(emit, include_reproduces_the_traced_rays)
 {
     const char *dir = test_tmpdir();
     for (int i = 0; i < 4; i++)
@@ -63,7 +63,7 @@ static void camera_for(const char *lens_name, const char *pupil, camera *c)
     cr_assert_eq(camera_setup(c, &l, &o, &err), 0, "%s", err.text);
 }
 
-Test(emit, rays_traced_back_land_on_their_film_points, .timeout = 60)
+Test(emit, rays_traced_back_land_on_their_film_points)
 {
     const char *dir = test_tmpdir();
     for (int i = 0; i < 4; i++)
