@@ -37,7 +37,7 @@ struct povmesh_emitter {
     vec3 anchor_camera_mm;     /* the front vertex: vertices are written relative to it */
     double triangle_size;      /* scene units */
     int decimals;
-    double decimal_scale, fixed_limit;
+    double decimal_scale, fixed_limit;   /* quanta per scene unit; |v| written as integers */
 };
 
 static int flush_text(text_out *t, l2p_error *err)
@@ -56,44 +56,45 @@ static void put_text(text_out *t, const char *s, size_t n)
 
 static void put_str(text_out *t, const char *s) { put_text(t, s, strlen(s)); }
 
+static const char DIGIT_PAIRS[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+/* Writes v in decimal, two digits a step. */
 static void put_uint(text_out *t, uint64_t v)
 {
     char tmp[24];
     int n = 0;
-    do {
-        tmp[n++] = (char)('0' + v % 10);
-        v /= 10;
-    } while (v);
+    while (v >= 100) {
+        const unsigned r = (unsigned)(v % 100);
+        v /= 100;
+        tmp[n++] = DIGIT_PAIRS[2 * r + 1];
+        tmp[n++] = DIGIT_PAIRS[2 * r];
+    }
+    if (v >= 10) {
+        tmp[n++] = DIGIT_PAIRS[2 * v + 1];
+        tmp[n++] = DIGIT_PAIRS[2 * v];
+    } else {
+        tmp[n++] = (char)('0' + v);
+    }
     while (n)
         t->buf[t->len++] = tmp[--n];
 }
 
-/* v to e->decimals decimals; values past the fixed-point range fall back to %.9g. */
+/* v in quanta of 10^-decimals scene units, as an integer rounded half away from zero; the
+   mesh's scale turns quanta back into scene units. Past the range of exact integers, %.9g. */
 static void put_number(text_out *t, const povmesh_emitter *e, double v)
 {
+    const double quanta = v * e->decimal_scale;
     if (!(fabs(v) < e->fixed_limit)) {
-        t->len += (size_t)snprintf(t->buf + t->len, 32, "%.9g", v);
+        t->len += (size_t)snprintf(t->buf + t->len, 32, "%.9g", quanta);
         return;
     }
-    int64_t k = llround(v * e->decimal_scale);
-    if (k < 0) {
+    const uint64_t k = (uint64_t)(fabs(quanta) + 0.5);
+    if (v < 0 && k != 0)
         t->buf[t->len++] = '-';
-        k = -k;
-    }
-    uint64_t whole = (uint64_t)k, frac = 0, p = 1;
-    for (int i = 0; i < e->decimals; i++)
-        p *= 10;
-    frac = whole % p;
-    whole /= p;
-    put_uint(t, whole);
-    if (e->decimals == 0)
-        return;
-    t->buf[t->len++] = '.';
-    for (int i = e->decimals - 1; i >= 0; i--) {
-        t->buf[t->len + (size_t)i] = (char)('0' + frac % 10);
-        frac /= 10;
-    }
-    t->len += (size_t)e->decimals;
+    put_uint(t, k);
 }
 
 static int reserve(text_out *t, size_t n, l2p_error *err)
@@ -226,10 +227,10 @@ static void put_camera(text_out *t, const povmesh_emitter *e)
     const vec3 w = camera_world_from_camera_point(e->cam, e->anchor_camera_mm);
     t->len += (size_t)snprintf(t->buf + t->len, 512,
         "  }\n}\ncamera {\n  mesh_camera {\n    1 0\n"
-        "    mesh { Lens2pov_Rays translate <%.17g, %.17g, %.17g> }\n  }\n}\n"
+        "    mesh { Lens2pov_Rays scale 1e-%d translate <%.17g, %.17g, %.17g> }\n  }\n}\n"
         "#undef Lens2pov_Rays\n"
         "#ifdef (Lens2pov_Version)\n  #version Lens2pov_Version;\n  #undef Lens2pov_Version\n#end\n",
-        w.x, w.y, w.z);
+        e->decimals, w.x, w.y, w.z);
 }
 
 static int write_ini(povmesh_emitter *e, chunk *ch, int index, long long rows, l2p_error *err)
@@ -274,14 +275,16 @@ static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)
     return write_ini(e, ch, index, (faces + e->packed_width - 1) / e->packed_width, err);
 }
 
-/* Numbers are written in fixed point with a quantum of about 1e-8 of the largest coordinate:
-   finer than float32, which is how POV-Ray stores mesh vertices. */
+/* Vertices are written as whole numbers of a quantum of about 1e-8 of the largest coordinate,
+   and the mesh is scaled by the quantum: POV-Ray stores vertices as float32 (24 bits) and
+   applies the scale in double, so this keeps all the precision POV-Ray can use in fewer
+   characters than decimals would take. */
 static void choose_number_format(povmesh_emitter *e, double largest)
 {
     int p = (int)ceil(-log10(largest * 1e-8));
     e->decimals = p < 0 ? 0 : p > 17 ? 17 : p;
     e->decimal_scale = pow(10.0, e->decimals);
-    e->fixed_limit = fmin(largest * 1e3, 9e17 / e->decimal_scale);
+    e->fixed_limit = fmin(largest * 1e3, 9e15 / e->decimal_scale);
 }
 
 static void choose_layout(povmesh_emitter *e, long long chunk_faces)

@@ -23,8 +23,9 @@
 typedef struct vd { __m128d p[PAIRS]; } vd;
 
 #define UNROLL _Pragma("GCC unroll 4")
+#define INLINE static inline __attribute__((always_inline))
 #define BINARY(name, op)                                                                  \
-    static inline vd name(vd a, vd b)                                                     \
+    INLINE vd name(vd a, vd b)                                                            \
     {                                                                                     \
         vd r;                                                                             \
         UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = op(a.p[i], b.p[i]);               \
@@ -44,49 +45,49 @@ BINARY(ge, _mm_cmpge_pd)
 BINARY(ne, _mm_cmpneq_pd)
 BINARY(vmax, _mm_max_pd)
 
-static inline vd splat(double x)
+INLINE vd splat(double x)
 {
     vd r;
     UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = _mm_set1_pd(x);
     return r;
 }
 
-static inline vd vsqrt(vd a)
+INLINE vd vsqrt(vd a)
 {
     vd r;
     UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = _mm_sqrt_pd(a.p[i]);
     return r;
 }
 
-static inline vd load(const double *x)
+INLINE vd load(const double *x)
 {
     vd r;
     UNROLL for (int i = 0; i < PAIRS; i++) r.p[i] = _mm_loadu_pd(x + 2 * i);
     return r;
 }
 
-static inline void store(double *x, vd v)
+INLINE void store(double *x, vd v)
 {
     UNROLL for (int i = 0; i < PAIRS; i++) _mm_storeu_pd(x + 2 * i, v.p[i]);
 }
 
-static inline int bits(vd mask)
+INLINE int bits(vd mask)
 {
     int r = 0;
     UNROLL for (int i = 0; i < PAIRS; i++) r |= _mm_movemask_pd(mask.p[i]) << (2 * i);
     return r;
 }
 
-static inline vd pick(vd mask, vd a, vd b) { return or(and(mask, a), andnot(mask, b)); }
-static inline vd neg(vd x) { return sub(splat(0), x); }
-static inline vd vabs(vd x) { return andnot(splat(-0.0), x); }
-static inline vd vcopysign(vd x, vd y) { return or(andnot(splat(-0.0), x), and(splat(-0.0), y)); }
-static inline vd dot(vd ax, vd ay, vd az, vd bx, vd by, vd bz)
+INLINE vd pick(vd mask, vd a, vd b) { return or(and(mask, a), andnot(mask, b)); }
+INLINE vd neg(vd x) { return sub(splat(0), x); }
+INLINE vd vabs(vd x) { return andnot(splat(-0.0), x); }
+INLINE vd vcopysign(vd x, vd y) { return or(andnot(splat(-0.0), x), and(splat(-0.0), y)); }
+INLINE vd dot(vd ax, vd ay, vd az, vd bx, vd by, vd bz)
 {
     return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
 }
 
-static inline vd root_ok(vd t0, vd t, vd pz, vd dz, vd c)
+INLINE vd root_ok(vd t0, vd t, vd pz, vd dz, vd c)
 {
     const vd ahead = ge(add(t0, t), splat(0));
     const vd finite = le(vabs(t), splat(DBL_MAX));
@@ -96,7 +97,7 @@ static inline vd root_ok(vd t0, vd t, vd pz, vd dz, vd c)
 
 /* Status per lane: missed, clipped, totally reflected, or still passing; returns the mask of
    lanes still passing. */
-static vd update_status(long long *status, int hit, int inside, int tir)
+INLINE vd update_status(long long *status, int hit, int inside, int tir)
 {
     double ok[LANES];
     for (int i = 0; i < LANES; i++) {
@@ -110,7 +111,7 @@ static vd update_status(long long *status, int hit, int inside, int tir)
 }
 
 /* The intersection: the point h on the vertex-side cap and whether there is one. */
-static inline vd intersect(const lens_surface *s, const vd o[3], const vd d[3], vd h[3])
+INLINE vd intersect(const lens_surface *s, const vd o[3], const vd d[3], vd h[3])
 {
     const double cs = s->curvature_per_mm;
     const vd c = splat(cs), zero = splat(0);

@@ -117,7 +117,7 @@ csv_ray *read_rays_csv(const char *path, size_t *count)
 }
 
 /* Parses just what the emitter writes: "vertex_vectors { N," then "<x,y,z>," per vertex,
-   "face_indices { M," then "<a,b,c>," per face, then "translate <x, y, z>". */
+   "face_indices { M," then "<a,b,c>," per face, then "scale S translate <x, y, z>". */
 pov_ray *read_include_as_povray(const char *path, size_t *count)
 {
     char *text = read_text(path, NULL);
@@ -145,6 +145,10 @@ pov_ray *read_include_as_povray(const char *path, size_t *count)
             p++;
         }
     }
+    /* The mesh's transform, applied in double: scale (uniform) then translate. */
+    p = strstr(p, "Lens2pov_Rays scale ");
+    cr_assert_not_null(p);
+    const double scale = strtod(p + 20, &p);
     p = strstr(p, "translate <");
     cr_assert_not_null(p);
     p += 11;
@@ -159,7 +163,7 @@ pov_ray *read_include_as_povray(const char *path, size_t *count)
             const float *x = v[f[i][k]];
             q[k] = v3(x[0], x[1], x[2]);
         }
-        const vec3 c = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
+        const vec3 c = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), scale / 3.0);
         r[i].o = v3_add(c, v3(t[0], t[1], t[2]));
         r[i].d = v3_normalize(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[1], q[0])));
     }

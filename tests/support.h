@@ -32,7 +32,7 @@ typedef struct csv_ray {
 csv_ray *read_rays_csv(const char *path, size_t *count);
 
 /* The rays an include gives POV-Ray: vertices as float32, origin = centroid, direction =
-   normalize((P3-P1) x (P2-P1)), then the translate, world space in scene units. */
+   normalize((P3-P1) x (P2-P1)), then the scale and translate, world space in scene units. */
 typedef struct pov_ray { vec3 o, d; } pov_ray;
 pov_ray *read_include_as_povray(const char *path, size_t *count);
 
