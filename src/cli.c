@@ -234,7 +234,7 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
         if (is_flag(c, a))
             continue;
         if (a[0] != '-' || a[1] == '\0') {
-            if (c->positional_count == 3)
+            if (c->positional_count == CLI_MAX_POSITIONAL)
                 return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unexpected argument '%s'", a);
             c->positional[c->positional_count++] = a;
             continue;

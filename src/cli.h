@@ -7,15 +7,17 @@
 #include "camera.h"
 #include "error.h"
 
+enum { CLI_MAX_POSITIONAL = 256 };
+
 typedef struct cli {
     camera_options cam;
-    const char *positional[3];
+    const char *positional[CLI_MAX_POSITIONAL];
     int positional_count;
     const char *output;          /* -o */
     const char *rays_csv;        /* --rays */
     const char *keep_temp;       /* --keep-temp */
     int jobs;                    /* --jobs, 0: the number of cores */
-    double memory_mb;            /* --memory-mb: POV-Ray memory budget per job */
+    double memory_mb;            /* --memory-mb: POV-Ray memory budget per process (chunks) */
     bool json;                   /* --json */
     bool quiet;                  /* --quiet: no progress bar */
     bool film_given;             /* any film or focus option was given (info prints more) */

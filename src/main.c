@@ -13,8 +13,8 @@
 static const char usage[] =
     "usage:\n"
     "  lens2pov info LENS [--json] [camera options]\n"
-    "  lens2pov trace LENS [camera options] -o PREFIX [--rays FILE.csv]\n"
-    "  lens2pov develop PREFIX RENDER.exr -o IMAGE      (.png, .exr or .tif)\n"
+    "  lens2pov trace LENS [camera options] -o PREFIX [--rays FILE.csv] [--memory-mb MB]\n"
+    "  lens2pov develop PREFIX [RENDER.exr ...] -o IMAGE   (.png, .exr or .tif)\n"
     "  lens2pov render SCENE.pov LENS [camera options] -o IMAGE [--jobs N] [--keep-temp DIR]\n"
     "camera options:\n"
     "  --width N --height N --spp N --film-diagonal MM --crop X0,Y0,X1,Y1\n"
@@ -83,7 +83,9 @@ static int cmd_trace(const cli *c, l2p_error *err)
     if (st || (st = load_camera(c, c->positional[0], &cam, err)))
         return st;
     raytable_stats stats;
-    st = raytable_write(&cam, c->output, c->rays_csv, 0, !c->quiet, NULL, NULL, &stats, err);
+    /* One include unless --memory-mb asks for chunks that fit a POV-Ray process each. */
+    const long long chunk_faces = c->memory_mb > 0 ? raytable_faces_for_memory(c->memory_mb) : 0;
+    st = raytable_write(&cam, c->output, c->rays_csv, chunk_faces, !c->quiet, NULL, NULL, &stats, err);
     if (!st && !c->quiet)
         fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%), %.2f s\n",
                 stats.passed, stats.samples, 100.0 * (double)stats.passed / (double)stats.samples,
@@ -92,22 +94,54 @@ static int cmd_trace(const cli *c, l2p_error *err)
     return st;
 }
 
+/* The renders of the chunks: as given, or by the names the chunks' .ini files give POV-Ray
+   (PREFIX.exr, or PREFIX.c000.exr, PREFIX.c001.exr, ...). */
+static char **render_names(const cli *c, long long chunks, l2p_error *err)
+{
+    const char *prefix = c->positional[0];
+    const long long given = c->positional_count - 1;
+    if (given && given != chunks) {
+        l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s.map has %lld chunk%s but %lld render%s given",
+                 prefix, chunks, chunks == 1 ? "" : "s", given, given == 1 ? " was" : "s were");
+        return NULL;
+    }
+    char **names = calloc((size_t)chunks, sizeof *names);
+    for (long long k = 0; names && k < chunks; k++) {
+        names[k] = malloc(strlen(prefix) + 32);
+        if (!names[k])
+            break;
+        if (given)
+            strcpy(names[k], c->positional[k + 1]);
+        else if (chunks == 1)
+            sprintf(names[k], "%s.exr", prefix);
+        else
+            sprintf(names[k], "%s.c%03lld.exr", prefix, k);
+    }
+    return names;
+}
+
 static int cmd_develop(const cli *c, l2p_error *err)
 {
-    int st = need(c, 2, true, err);
-    if (st)
-        return st;
+    if (c->positional_count < 1 || !c->output)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "develop takes PREFIX [RENDER.exr ...] -o IMAGE");
     char *map_path = malloc(strlen(c->positional[0]) + 8);
     if (!map_path)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     sprintf(map_path, "%s.map", c->positional[0]);
     samplemap map;
-    st = samplemap_read(map_path, &map, err);
+    int st = samplemap_read(map_path, &map, err);
     free(map_path);
     if (st)
         return st;
-    const char *renders[1] = {c->positional[1]};
-    st = develop_files(&map, renders, 1, c->output, err);
+    const long long chunks = samplemap_chunk_count(&map.header);
+    char **names = render_names(c, chunks, err);
+    if (names)
+        st = develop_files(&map, (const char *const *)names, (int)chunks, c->output, err);
+    else
+        st = err->status;
+    for (long long k = 0; names && k < chunks; k++)
+        free(names[k]);
+    free(names);
     samplemap_free(&map);
     return st;
 }

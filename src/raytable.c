@@ -4,6 +4,13 @@
 #include <time.h>
 #include "progress.h"
 
+long long raytable_faces_for_memory(double memory_mb)
+{
+    const double mb = memory_mb > 0 ? memory_mb : RAYTABLE_DEFAULT_MEMORY_MB;
+    const long long faces = (long long)(mb * 1048576.0 / 265.0);
+    return faces > 0 ? faces : 1;
+}
+
 static double now_seconds(void)
 {
     struct timespec ts;

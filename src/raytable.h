@@ -12,6 +12,13 @@ typedef struct raytable_stats {
     double seconds;
 } raytable_stats;
 
+/* POV-Ray needs about 265 bytes of memory per mesh_camera face (measured: see
+   ../shared/docs/povray-mesh-camera.md); the default budget is 1 GB a process. */
+#define RAYTABLE_DEFAULT_MEMORY_MB 1024.0
+
+/* Faces per chunk for a POV-Ray memory budget in MB (<= 0: the default). */
+long long raytable_faces_for_memory(double memory_mb);
+
 /* Traces crop pixels x spp samples and writes PREFIX.inc/.ini/.map (and csv_path when not
    NULL); chunk_faces as for povmesh_open. All outputs appear together or not at all. */
 int raytable_write(const camera *c, const char *prefix, const char *csv_path,

@@ -14,11 +14,6 @@
 #include "povray.h"
 #include "raytable.h"
 
-/* POV-Ray needs about 265 bytes of memory per mesh_camera face (measured, see
-   ../shared/docs/povray-mesh-camera.md); the default budget is 1 GB a process. */
-static const double POVRAY_BYTES_PER_FACE = 265.0;
-static const double DEFAULT_MEMORY_MB = 1024.0;
-
 static int check_inputs(const cli *c, l2p_error *err)
 {
     if (c->positional_count != 2)
@@ -46,8 +41,7 @@ static int number_of_cores(void)
    which POV-Ray does on one thread, run side by side. */
 static long long chunk_faces_for(const camera *cam, const cli *c, int jobs)
 {
-    const double mb = c->memory_mb > 0 ? c->memory_mb : DEFAULT_MEMORY_MB;
-    long long budget = (long long)(mb * 1048576.0 / POVRAY_BYTES_PER_FACE);
+    long long budget = raytable_faces_for_memory(c->memory_mb);
     const long long most = (long long)(cam->crop_x1 - cam->crop_x0) *
                            (cam->crop_y1 - cam->crop_y0) * cam->samples.spp;
     long long even = (most + jobs - 1) / jobs;
