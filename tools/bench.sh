@@ -25,3 +25,26 @@ t2=$(date +%s.%N)
 awk -v a="$t0" -v b="$t1" -v c="$t2" -v n="$faces" 'BEGIN {
   printf "lens2pov trace: %.2f s   povray (parse + render, 1 thread): %.2f s   ratio %.1f%%   (%d faces)\n",
          b - a, c - b, 100 * (b - a) / (c - b), n }'
+
+# Medians of three runs of a command, in seconds.
+median3() {
+  for i in 1 2 3; do
+    s=$(date +%s.%N); "$@" >/dev/null 2>&1; e=$(date +%s.%N)
+    echo "$s $e" | awk '{ print $2 - $1 }'
+  done | sort -n | sed -n 2p
+}
+
+echo "== lens2pov render against POV-Ray's perspective camera, same primary rays (median of 3)"
+W=320 H=240 SPP=16
+scene=pov/scene.pov
+lens_t=$(median3 "$build/lens2pov" render "$scene" lenses/dgauss.50mm.dat --width $W --height $H \
+    --spp $SPP --location 0,1.2,-4 --look-at 0,1,0 -o "$work/lens.png" --quiet)
+pov_t=$(median3 sh -c "cd pov && povray scene.pov +W$W +H$((H * SPP)) -A -D -V -GA +FE +O'$work/own.exr'")
+awk -v a="$lens_t" -v b="$pov_t" -v n=$((W * H * SPP)) 'BEGIN {
+  printf "%d primary rays: lens2pov render %.2f s, povray perspective %.2f s, ratio %.2f (target <= 1.5)\n", n, a, b, a / b }'
+
+echo "== chunked parallel parse: one POV-Ray process against two (same picture, median of 3)"
+one=$(median3 "$build/lens2pov" render "$scene" lenses/dgauss.50mm.dat --width $W --height $H \
+    --spp $SPP --location 0,1.2,-4 --look-at 0,1,0 -o "$work/one.png" --quiet --jobs 1)
+awk -v a="$one" -v b="$lens_t" 'BEGIN {
+  printf "--jobs 1: %.2f s, --jobs 2: %.2f s, speed-up %.2f\n", a, b, a / b }'
