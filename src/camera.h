@@ -68,7 +68,5 @@ void camera_trace_batch(const camera *c, const vec3 *film_points, const double *
 vec3 camera_world_from_camera_point(const camera *c, vec3 p);
 vec3 camera_world_from_camera_dir(const camera *c, vec3 d);
 
-/* Entrance pupil (the stop seen through the surfaces in front of it): plane and radius. */
-int camera_entrance_pupil(const lens *l, double *z_mm, double *radius_mm, l2p_error *err);
 
 #endif

@@ -5,6 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Limits of option values (see where they are used). */
+#define UNIT_MM_LEAST 1e-3
+#define UNIT_MM_MOST 1e9
+#define JOBS_MOST 256
+#define MEMORY_MB_MOST 1073741824.0
+#define FILM_PIXELS_MOST 4294967296LL
+
 static int bad(l2p_error *err, const char *opt, const char *want, const char *got)
 {
     return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s: expected %s, got '%s'", opt, want, got);
@@ -61,13 +68,26 @@ static bool parse_vec3(const char *s, vec3 *v)
     return true;
 }
 
+/* "X0,Y0,X1,Y1", four whole numbers (strtol, not sscanf's %d: out-of-range digits are
+   refused instead of being undefined behaviour). */
 static bool parse_crop(const char *s, camera_options *o)
 {
-    int v[4], used = 0;
-    char tail;
-    if (sscanf(s, "%d,%d,%d,%d%n%c", &v[0], &v[1], &v[2], &v[3], &used, &tail) != 4 ||
-        s[used] != '\0')
+    int v[4];
+    char buf[128];
+    if (strlen(s) >= sizeof buf)
         return false;
+    memcpy(buf, s, strlen(s) + 1);
+    char *part = buf;
+    for (int i = 0; i < 4; i++) {
+        char *comma = strchr(part, ',');
+        if ((i < 3) != (comma != NULL))
+            return false;
+        if (comma)
+            *comma = '\0';
+        if (!parse_int(part, &v[i]))
+            return false;
+        part = comma ? comma + 1 : part;
+    }
     o->crop_x0 = v[0];
     o->crop_y0 = v[1];
     o->crop_x1 = v[2];
@@ -86,6 +106,29 @@ static int positive_double(const char *opt, const char *v, double *out, l2p_erro
 {
     if (!parse_double(v, out) || !(*out > 0.0))
         return bad(err, opt, "a positive number", v);
+    return L2P_OK;
+}
+
+/* A whole number in [1, most]. */
+static int int_up_to(const char *opt, const char *v, int most, int *out, l2p_error *err)
+{
+    if (!parse_int(v, out) || *out <= 0 || *out > most) {
+        char want[64];
+        snprintf(want, sizeof want, "a whole number from 1 to %d", most);
+        return bad(err, opt, want, v);
+    }
+    return L2P_OK;
+}
+
+/* A number in [least, most]. */
+static int double_in(const char *opt, const char *v, double least, double most, double *out,
+                     l2p_error *err)
+{
+    if (!parse_double(v, out) || !(*out >= least && *out <= most)) {
+        char want[96];
+        snprintf(want, sizeof want, "a number from %g to %g", least, most);
+        return bad(err, opt, want, v);
+    }
     return L2P_OK;
 }
 
@@ -160,8 +203,11 @@ static int place_option(cli *c, const char *opt, const char *v, l2p_error *err)
         return parse_vec3(v, &o->look_at) ? 0 : bad(err, opt, "x,y,z", v);
     if (!strcmp(opt, "--sky"))
         return parse_vec3(v, &o->sky) ? 0 : bad(err, opt, "x,y,z", v);
+    /* Millimetres in a scene unit: from a micrometre to a thousand kilometres. Beyond, the
+       ray table's triangles (a lens aperture in scene units) leave float32, which is how
+       POV-Ray stores mesh vertices: they overflow to infinity or collapse to a point. */
     if (!strcmp(opt, "--unit-mm"))
-        return positive_double(opt, v, &o->unit_mm, err);
+        return double_in(opt, v, UNIT_MM_LEAST, UNIT_MM_MOST, &o->unit_mm, err);
     return -1;
 }
 
@@ -173,10 +219,12 @@ static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
         c->rays_csv = v;
     else if (!strcmp(opt, "--keep-temp"))
         c->keep_temp = v;
-    else if (!strcmp(opt, "--jobs"))
-        return positive_int(opt, v, &c->jobs, err);
-    else if (!strcmp(opt, "--memory-mb"))
-        return positive_double(opt, v, &c->memory_mb, err);
+    else if (!strcmp(opt, "--jobs"))   /* outfile.c stops at most 256 children on a signal */
+        return int_up_to(opt, v, JOBS_MOST, &c->jobs, err);
+    else if (!strcmp(opt, "--memory-mb"))  /* up to 1 PiB: render converts it to a face count */
+        return positive_double(opt, v, &c->memory_mb, err) ? L2P_BAD_INPUT
+               : c->memory_mb > MEMORY_MB_MOST ? bad(err, opt, "a positive number up to 1073741824", v)
+                                               : L2P_OK;
     else
         return -1;
     if (!*v)
@@ -198,9 +246,29 @@ static int value_option(cli *c, const char *opt, const char *v, l2p_error *err)
     return st;
 }
 
+/* --rays naming one of the other outputs: both would be renamed into place, the last wins. */
+static bool same_output(const char *rays, const char *output)
+{
+    static const char *const ext[] = {"", ".inc", ".ini", ".map"};
+    const size_t n = strlen(output);
+    for (int i = 0; i < 4; i++)
+        if (!strncmp(rays, output, n) && !strcmp(rays + n, ext[i]))
+            return true;
+    return false;
+}
+
 static int check_contradictions(const cli *c, l2p_error *err)
 {
     const camera_options *o = &c->cam;
+    /* The sample map numbers film pixels y * width + x in 32 bits. */
+    if ((long long)o->width * o->height > FILM_PIXELS_MOST)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--width %d x --height %d is %lld pixels: at most %lld (2^32)", o->width,
+                        o->height, (long long)o->width * o->height, FILM_PIXELS_MOST);
+    if (c->rays_csv && c->output && same_output(c->rays_csv, c->output))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--rays %s would overwrite an output of -o %s: give another file",
+                        c->rays_csv, c->output);
     if (!isnan(o->film_distance_mm) && !isnan(o->focus_distance_units))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--film-distance and --focus-distance both set the focus: give one");

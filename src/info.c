@@ -15,7 +15,7 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
     double ep_z, ep_r;
     int st = thick_lens_of(&l, 0, l.count - 1, &t, err);
     if (!st)
-        st = camera_entrance_pupil(&l, &ep_z, &ep_r, err);
+        st = pupil_stop_image(&l, false, &ep_z, &ep_r, err);
     if (!st)
         st = pupil_make(&l, PUPIL_STOP_IMAGE, &exit, err);
     if (!st) {

@@ -17,27 +17,30 @@ int pupil_kind_parse(const char *name, pupil_kind *k)
     return -1;
 }
 
-/* The stop imaged by the surfaces behind it: its centre's conjugate gives the plane, its rim's
-   conjugate the radius. */
-static int stop_image(const lens *l, pupil *out, l2p_error *err)
+int pupil_stop_image(const lens *l, bool toward_film, double *z_mm, double *radius_mm,
+                     l2p_error *err)
 {
     const lens_surface *stop = &l->surface[l->stop];
-    if (l->stop == l->count - 1) {
-        out->z_mm = stop->vertex_z_mm;
-        out->radius_mm = 0.5 * l->stop_diameter_mm;
+    const int first = toward_film ? l->stop + 1 : 0, last = toward_film ? l->count - 1 : l->stop - 1;
+    if (first > last) {           /* nothing on that side: the stop is its own image */
+        *z_mm = stop->vertex_z_mm;
+        *radius_mm = 0.5 * l->stop_diameter_mm;
         return L2P_OK;
     }
     thick_lens t;
-    int st = thick_lens_of(l, l->stop + 1, l->count - 1, &t, err);
+    int st = thick_lens_of(l, first, last, &t, err);
     if (st)
         return st;
-    vec3 rim;
-    if (!thick_image_from_real(&t, v3(0.5 * l->stop_diameter_mm, 0, stop->vertex_z_mm), &rim))
+    const vec3 rim = v3(0.5 * l->stop_diameter_mm, 0, stop->vertex_z_mm);
+    vec3 image;
+    if (!(toward_film ? thick_image_from_real(&t, rim, &image) : thick_real_from_image(&t, rim, &image)))
         return l2p_fail(err, L2P_BAD_INPUT, l->path, stop->line,
-                        "the stop lies in the front focal plane of the surfaces behind it: its "
-                        "image is at infinity (use --pupil rear)");
-    out->z_mm = rim.z;
-    out->radius_mm = fabs(rim.x);
+                        "the %s pupil is at infinity: the stop lies in a focal plane of the "
+                        "surfaces %s it%s", toward_film ? "exit" : "entrance",
+                        toward_film ? "behind" : "in front of",
+                        toward_film ? " (use --pupil rear)" : "");
+    *z_mm = image.z;
+    *radius_mm = fabs(image.x);
     return L2P_OK;
 }
 
@@ -52,10 +55,13 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err)
         out->radius_mm = 0.5 * rear->aperture_mm;
         out->z_mm = rear->vertex_z_mm + lens_sag_mm(rear, out->radius_mm);
     } else {
-        int st = stop_image(l, out, err);
+        int st = pupil_stop_image(l, true, &out->z_mm, &out->radius_mm, err);
         if (st)
             return st;
     }
+    for (int i = 0; i < PUPIL_RINGS; i++)
+        out->ring_radius_mm[i] = out->radius_mm;
+    out->ring_width_mm = 0.0;
     if (!(fabs(out->z_mm) > 1e-9 * (1.0 + out->radius_mm)) || !(out->radius_mm > 0.0))
         return l2p_fail(err, L2P_BAD_INPUT, l->path, 0,
                         "the %s exit pupil lies in the film plane; choose another --pupil or "
@@ -82,17 +88,27 @@ void concentric_disk(double u, double v, double *x, double *y)
     *y = r * sin(phi);
 }
 
+vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
+{
+    /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */
+    const vec3 d = v3_sub(v3(x_mm, y_mm, pu->z_mm), film_point);
+    return v3_normalize(pu->z_mm < 0.0 ? v3_scale(d, -1.0) : d);
+}
+
+double pupil_ring_radius_mm(const pupil *pu, vec3 film_point)
+{
+    const double r = hypot(film_point.x, film_point.y);
+    int ring = pu->ring_width_mm > 0.0 ? (int)fmin(r / pu->ring_width_mm, PUPIL_RINGS - 1) : 0;
+    return pu->ring_radius_mm[ring < 0 ? 0 : ring];
+}
+
 double pupil_film_ray(const pupil *pu, vec3 film_point, double u, double v, vec3 *direction)
 {
     double dx, dy;
     concentric_disk(u, v, &dx, &dy);
-    const vec3 target = v3(dx * pu->radius_mm, dy * pu->radius_mm, pu->z_mm);
-    /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */
-    vec3 d = v3_sub(target, film_point);
-    if (pu->z_mm < 0.0)
-        d = v3_scale(d, -1.0);
-    *direction = v3_normalize(d);
+    const double radius = pupil_ring_radius_mm(pu, film_point);
+    *direction = pupil_direction(pu, film_point, dx * radius, dy * radius);
     const double cos_theta = direction->z;
-    const double area = M_PI * pu->radius_mm * pu->radius_mm;
+    const double area = M_PI * radius * radius;
     return area * (cos_theta * cos_theta) * (cos_theta * cos_theta) / (pu->z_mm * pu->z_mm);
 }

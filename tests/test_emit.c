@@ -149,7 +149,7 @@ Test(emit, normalized_weights_average_one_at_the_centre)
     for (int p = 0; p < 3; p++) {
         camera c;
         camera_for("dgauss.50mm", PUPILS[p], &c);
-        enum { N = 200 };
+        enum { N = 1000 };
         double sum = 0;
         for (int j = 0; j < N; j++)
             for (int i = 0; i < N; i++) {
@@ -158,9 +158,10 @@ Test(emit, normalized_weights_average_one_at_the_centre)
                 if (camera_trace(&c, v3(0, 0, 0), (i + 0.5) / N, (j + 0.5) / N, &r, &w))
                     sum += w;
             }
-        /* The normalization uses a 48 x 48 grid; a 200 x 200 grid differs by the grid error
-           of the vignetted rim, well under 1%. */
-        cr_assert_float_eq(sum / (N * N), 1.0, 0.01, "%s: %g", PUPILS[p], sum / (N * N));
+        /* An independent estimate: a 1000 x 1000 grid over the pupil, against the exact cone
+           integral the camera normalizes with. The grid's error at the edge of the passing
+           region is first order, about 0.1% here (0.6% at 256 x 256). */
+        cr_assert_float_eq(sum / ((double)N * N), 1.0, 0.004, "%s: %g", PUPILS[p], sum / ((double)N * N));
         camera_free(&c);
     }
 }
