@@ -361,20 +361,25 @@ int povmesh_open(povmesh_emitter **out, const camera *c, const char *prefix, con
     return L2P_OK;
 }
 
-static int put_csv_row(povmesh_emitter *e, const emitted_ray *r, l2p_error *err)
+bool povmesh_wants_csv(const povmesh_emitter *e) { return e->has_csv; }
+
+size_t povmesh_format_ray(const povmesh_emitter *e, const emitted_ray *r, char *text,
+                          samplemap_record *rec, char *csv, size_t *csv_len)
 {
-    int st = reserve(&e->csv, 512, err);
-    if (st)
-        return st;
-    text_out *t = &e->csv;
-    t->len += (size_t)snprintf(t->buf + t->len, 512,
-        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-        r->px + r->offset_x, r->py + r->offset_y, r->film_point.x, r->film_point.y,
-        r->out.o.x, r->out.o.y, r->out.o.z, r->out.d.x, r->out.d.y, r->out.d.z, r->weight);
-    return L2P_OK;
+    text_out t = {.buf = text, .len = 0};
+    put_ray(&t, e, &r->out);
+    *rec = (samplemap_record){(uint32_t)r->py * (uint32_t)e->cam->film.width + (uint32_t)r->px,
+                              (float)r->offset_x, (float)r->offset_y, (float)r->weight};
+    if (csv)
+        *csv_len = (size_t)snprintf(csv, POVMESH_CSV_MAX,
+            "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+            r->px + r->offset_x, r->py + r->offset_y, r->film_point.x, r->film_point.y,
+            r->out.o.x, r->out.o.y, r->out.o.z, r->out.d.x, r->out.d.y, r->out.d.z, r->weight);
+    return t.len;
 }
 
-int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err)
+int povmesh_append(povmesh_emitter *e, const char *text, size_t len, const samplemap_record *rec,
+                   const char *csv, size_t csv_len, l2p_error *err)
 {
     int st;
     chunk *ch = &e->chunks[e->chunk_count - 1];
@@ -383,16 +388,28 @@ int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err)
             return st;
         ch = &e->chunks[e->chunk_count - 1];
     }
-    if ((st = reserve(&ch->inc, 1024, err)) != 0)
+    if ((st = reserve(&ch->inc, len, err)) != 0)
         return st;
-    put_ray(&ch->inc, e, &r->out);
+    put_text(&ch->inc, text, len);
     ch->faces++;
     e->faces++;
-    const samplemap_record rec = {(uint32_t)r->py * (uint32_t)e->cam->film.width + (uint32_t)r->px,
-                                  (float)r->offset_x, (float)r->offset_y, (float)r->weight};
-    if (samplemap_append(e->map.fp, &rec, 1) != 0)
+    if (samplemap_append(e->map.fp, rec, 1) != 0)
         return l2p_fail(err, L2P_FAILED, e->map.final_path, 0, "write failed");
-    return e->has_csv ? put_csv_row(e, r, err) : L2P_OK;
+    if (!e->has_csv)
+        return L2P_OK;
+    if ((st = reserve(&e->csv, csv_len, err)) != 0)
+        return st;
+    put_text(&e->csv, csv, csv_len);
+    return L2P_OK;
+}
+
+int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err)
+{
+    char text[POVMESH_RAY_TEXT_MAX], csv[POVMESH_CSV_MAX];
+    samplemap_record rec;
+    size_t csv_len = 0;
+    const size_t len = povmesh_format_ray(e, r, text, &rec, e->has_csv ? csv : NULL, &csv_len);
+    return povmesh_append(e, text, len, &rec, csv, csv_len, err);
 }
 
 static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)

@@ -13,6 +13,7 @@
 #include <stdint.h>
 #include "camera.h"
 #include "error.h"
+#include "samplemap.h"
 
 typedef struct emitted_ray {
     int px, py;                 /* film pixel */
@@ -36,6 +37,17 @@ int povmesh_open(povmesh_emitter **e, const camera *c, const char *prefix, const
                  long long chunk_faces, l2p_error *err);
 
 int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err);
+
+/* povmesh_add in two steps, so that threads can format rays side by side while one of them
+   appends in face order. Formatting reads the emitter and writes only its arguments: the
+   ray's vertex text (at most POVMESH_RAY_TEXT_MAX bytes; returns its length), its sample-map
+   record and, when csv is not NULL, its CSV row (at most POVMESH_CSV_MAX bytes). */
+enum { POVMESH_RAY_TEXT_MAX = 512, POVMESH_CSV_MAX = 512 };
+size_t povmesh_format_ray(const povmesh_emitter *e, const emitted_ray *r, char *text,
+                          samplemap_record *rec, char *csv, size_t *csv_len);
+int povmesh_append(povmesh_emitter *e, const char *text, size_t len, const samplemap_record *rec,
+                   const char *csv, size_t csv_len, l2p_error *err);
+bool povmesh_wants_csv(const povmesh_emitter *e);
 
 /* Completes every file and renames them all into place (commit), or removes them; frees e.
    After a commit, *chunks (when not NULL) gets the chunks written, owned by the caller. */

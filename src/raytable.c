@@ -1,7 +1,9 @@
 #include "raytable.h"
 
+#include <pthread.h>
 #include <stdlib.h>
 #include <time.h>
+#include <unistd.h>
 #include "progress.h"
 
 long long raytable_faces_for_memory(double memory_mb)
@@ -18,6 +20,43 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Rows of the film are traced and formatted by worker threads, one row each at a time, and
+   appended to the outputs in row order by the calling thread: the files are the same bytes
+   whatever the number of threads. */
+
+/* One traced and formatted row. */
+typedef struct row_out {
+    char *text;                /* the vertex text of the passed rays, one after the other */
+    size_t text_len, text_cap;
+    size_t *length;            /* of each passed ray's text */
+    samplemap_record *record;
+    char *csv;                 /* their CSV rows, when asked for */
+    size_t csv_len, csv_cap, *csv_length;
+    long long samples, passed;
+} row_out;
+
+static int row_reserve(row_out *o, long long rays, bool csv)
+{
+    const size_t n = (size_t)rays;
+    o->text_cap = n * POVMESH_RAY_TEXT_MAX;
+    o->csv_cap = csv ? n * POVMESH_CSV_MAX : 0;
+    o->text = malloc(o->text_cap + 1);
+    o->length = malloc(n * sizeof *o->length + 1);
+    o->record = malloc(n * sizeof *o->record + 1);
+    o->csv = malloc(o->csv_cap + 1);
+    o->csv_length = malloc(n * sizeof *o->csv_length + 1);
+    return o->text && o->length && o->record && o->csv && o->csv_length ? 0 : -1;
+}
+
+static void row_free(row_out *o)
+{
+    free(o->text);
+    free(o->length);
+    free(o->record);
+    free(o->csv);
+    free(o->csv_length);
+}
+
 /* The samples of one film row, CAMERA_BATCH at a time, in pixel-then-sample order (the order
    of the faces, whatever the batch size). */
 typedef struct batch {
@@ -29,28 +68,30 @@ typedef struct batch {
     bool passed[CAMERA_BATCH];
 } batch;
 
-static int flush_batch(const camera *c, povmesh_emitter *e, batch *b, raytable_stats *stats,
-                       l2p_error *err)
+static void flush_batch(const camera *c, const povmesh_emitter *e, batch *b, row_out *o)
 {
     camera_trace_batch(c, b->film, b->u, b->v, b->n, b->out, b->weight, b->passed);
-    stats->samples += b->n;
+    o->samples += b->n;
+    const bool csv = povmesh_wants_csv(e);
     for (int k = 0; k < b->n; k++) {
         if (!b->passed[k])
             continue;
-        stats->passed++;
         b->r[k].out = b->out[k];
         b->r[k].weight = b->weight[k];
-        int st = povmesh_add(e, &b->r[k], err);
-        if (st)
-            return st;
+        const long long i = o->passed++;
+        o->length[i] = povmesh_format_ray(e, &b->r[k], o->text + o->text_len, &o->record[i],
+                                          csv ? o->csv + o->csv_len : NULL, &o->csv_length[i]);
+        o->text_len += o->length[i];
+        if (csv)
+            o->csv_len += o->csv_length[i];
     }
     b->n = 0;
-    return L2P_OK;
 }
 
-static int trace_row(const camera *c, povmesh_emitter *e, int py, batch *b, raytable_stats *stats,
-                     l2p_error *err)
+static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *b, row_out *o)
 {
+    o->text_len = o->csv_len = 0;
+    o->samples = o->passed = 0;
     for (int px = c->crop_x0; px < c->crop_x1; px++)
         for (int k = 0; k < c->samples.spp; k++) {
             const film_sample s = sample_pattern_get(&c->samples, px, py, k);
@@ -63,13 +104,143 @@ static int trace_row(const camera *c, povmesh_emitter *e, int py, batch *b, rayt
                 film_camera_from_raster(&c->film, px + s.offset_x, py + s.offset_y);
             b->u[b->n] = s.pupil_u;
             b->v[b->n] = s.pupil_v;
-            if (++b->n == CAMERA_BATCH) {
-                int st = flush_batch(c, e, b, stats, err);
-                if (st)
-                    return st;
-            }
+            if (++b->n == CAMERA_BATCH)
+                flush_batch(c, e, b, o);
         }
-    return flush_batch(c, e, b, stats, err);
+    flush_batch(c, e, b, o);
+}
+
+static int append_row(povmesh_emitter *e, const row_out *o, raytable_stats *stats, l2p_error *err)
+{
+    size_t at = 0, csv_at = 0;
+    for (long long i = 0; i < o->passed; i++) {
+        const size_t csv_len = povmesh_wants_csv(e) ? o->csv_length[i] : 0;
+        int st = povmesh_append(e, o->text + at, o->length[i], &o->record[i], o->csv + csv_at,
+                                csv_len, err);
+        if (st)
+            return st;
+        at += o->length[i];
+        csv_at += csv_len;
+    }
+    stats->samples += o->samples;
+    stats->passed += o->passed;
+    return L2P_OK;
+}
+
+/* The workers and the writer share a ring of row slots. */
+enum { SLOT_FREE, SLOT_BUSY, SLOT_READY };
+
+typedef struct shared {
+    const camera *cam;
+    const povmesh_emitter *emitter;
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    int next_row, end_row, first_row, slots;
+    int written_row;           /* rows before it are written: their slots are free */
+    bool abort;
+    row_out *slot;
+    int *state, *row_of;
+} shared;
+
+static void *worker(void *arg)
+{
+    shared *sh = arg;
+    batch *b = malloc(sizeof *b);
+    pthread_mutex_lock(&sh->lock);
+    while (b && !sh->abort && sh->next_row < sh->end_row) {
+        const int py = sh->next_row++, k = (py - sh->first_row) % sh->slots;
+        /* Row py takes slot k once row py - slots, its last user, is written; waiting only for
+           the slot to be free would let a later row take it first and deadlock. */
+        while (py >= sh->written_row + sh->slots && !sh->abort)
+            pthread_cond_wait(&sh->changed, &sh->lock);
+        if (sh->abort)
+            break;
+        sh->state[k] = SLOT_BUSY;
+        sh->row_of[k] = py;
+        pthread_mutex_unlock(&sh->lock);
+        b->n = 0;
+        trace_row(sh->cam, sh->emitter, py, b, &sh->slot[k]);
+        pthread_mutex_lock(&sh->lock);
+        sh->state[k] = SLOT_READY;
+        pthread_cond_broadcast(&sh->changed);
+    }
+    if (!b)
+        sh->abort = true;   /* the writer sees a row that never comes and stops */
+    pthread_cond_broadcast(&sh->changed);
+    pthread_mutex_unlock(&sh->lock);
+    free(b);
+    return NULL;
+}
+
+/* The writer: rows in order as the workers finish them. */
+static int write_rows(shared *sh, povmesh_emitter *e, progress *bar, raytable_stats *stats,
+                      l2p_error *err)
+{
+    int st = L2P_OK;
+    for (int py = sh->first_row; py < sh->end_row && !st; py++) {
+        const int k = (py - sh->first_row) % sh->slots;
+        pthread_mutex_lock(&sh->lock);
+        while (!(sh->state[k] == SLOT_READY && sh->row_of[k] == py) && !sh->abort)
+            pthread_cond_wait(&sh->changed, &sh->lock);
+        const bool aborted = sh->abort;
+        pthread_mutex_unlock(&sh->lock);
+        if (aborted)
+            return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+        st = append_row(e, &sh->slot[k], stats, err);
+        pthread_mutex_lock(&sh->lock);
+        sh->state[k] = SLOT_FREE;
+        sh->written_row = py + 1;
+        pthread_cond_broadcast(&sh->changed);
+        pthread_mutex_unlock(&sh->lock);
+        progress_update(bar, (double)(py - sh->first_row + 1) / (sh->end_row - sh->first_row), NULL);
+    }
+    return st;
+}
+
+static int number_of_workers(void)
+{
+    const long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 16 ? 16 : (int)n;
+}
+
+static int trace_rows(const camera *c, povmesh_emitter *e, progress *bar, raytable_stats *stats,
+                      l2p_error *err)
+{
+    const int workers = number_of_workers();
+    shared sh = {.cam = c, .emitter = e, .next_row = c->crop_y0, .end_row = c->crop_y1,
+                 .first_row = c->crop_y0, .written_row = c->crop_y0, .slots = 2 * workers};
+    sh.slot = calloc((size_t)sh.slots, sizeof *sh.slot);
+    sh.state = calloc((size_t)sh.slots, sizeof *sh.state);
+    sh.row_of = calloc((size_t)sh.slots, sizeof *sh.row_of);
+    const long long rays = (long long)(c->crop_x1 - c->crop_x0) * c->samples.spp;
+    int st = sh.slot && sh.state && sh.row_of ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < sh.slots && !st; k++)
+        if (row_reserve(&sh.slot[k], rays, povmesh_wants_csv(e)))
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    pthread_t thread[16];
+    int started = 0;
+    pthread_mutex_init(&sh.lock, NULL);
+    pthread_cond_init(&sh.changed, NULL);
+    while (!st && started < workers && pthread_create(&thread[started], NULL, worker, &sh) == 0)
+        started++;
+    if (!st && started == 0)
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
+    if (!st)
+        st = write_rows(&sh, e, bar, stats, err);
+    pthread_mutex_lock(&sh.lock);
+    sh.abort = true;
+    pthread_cond_broadcast(&sh.changed);
+    pthread_mutex_unlock(&sh.lock);
+    for (int i = 0; i < started; i++)
+        pthread_join(thread[i], NULL);
+    for (int k = 0; sh.slot && k < sh.slots; k++)
+        row_free(&sh.slot[k]);
+    free(sh.slot);
+    free(sh.state);
+    free(sh.row_of);
+    pthread_mutex_destroy(&sh.lock);
+    pthread_cond_destroy(&sh.changed);
+    return st;
 }
 
 int raytable_write(const camera *c, const char *prefix, const char *csv_path,
@@ -84,17 +255,7 @@ int raytable_write(const camera *c, const char *prefix, const char *csv_path,
         return st;
     progress bar;
     progress_start(&bar, "tracing", show_progress);
-    const int rows = c->crop_y1 - c->crop_y0;
-    batch *b = malloc(sizeof *b);
-    if (!b)
-        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    else
-        b->n = 0;
-    for (int py = c->crop_y0; py < c->crop_y1 && !st; py++) {
-        st = trace_row(c, e, py, b, &local, err);
-        progress_update(&bar, (double)(py - c->crop_y0 + 1) / rows, NULL);
-    }
-    free(b);
+    st = trace_rows(c, e, &bar, &local, err);
     progress_finish(&bar);
     int close_st = povmesh_close(e, st == L2P_OK, chunks, chunk_count, err);
     local.seconds = now_seconds() - start;
