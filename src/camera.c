@@ -81,6 +81,36 @@ static int setup_aperture(lens *l, const camera_options *o, double efl_mm, l2p_e
     return L2P_OK;
 }
 
+/* The film must lie behind every surface's rim, and not so far that the table's absolute
+   camera-space coordinates lose the rays' precision (trace-back error grows with the square of
+   the film distance: 0.04 mm at 1e8 mm). */
+static const double FILM_DISTANCE_MAX_RATIO = 1000.0;
+
+static int check_film_position(const lens *l, bool from_option, double focus_mm, l2p_error *err)
+{
+    double size = lens_total_length_mm(l);
+    for (int i = 0; i < l->count; i++) {
+        const lens_surface *s = &l->surface[i];
+        size = fmax(size, s->aperture_mm);
+        const double lowest = s->vertex_z_mm + fmin(0.0, lens_sag_mm(s, 0.5 * s->aperture_mm));
+        if (lowest < 0.0)
+            return l2p_fail(err, L2P_BAD_INPUT, l->path, s->line,
+                            "the film (%g mm behind the rear vertex) is inside the lens: the rim "
+                            "of this surface reaches %g mm behind it", l->film_distance_mm, -lowest);
+    }
+    if (l->film_distance_mm <= FILM_DISTANCE_MAX_RATIO * size)
+        return L2P_OK;
+    if (from_option)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--film-distance %g mm is too far from the lens: %.3g times its size, at "
+                        "most %g", l->film_distance_mm, l->film_distance_mm / size,
+                        FILM_DISTANCE_MAX_RATIO);
+    return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[0].line,
+                    "focusing at %g mm puts the film %g mm behind the lens, too far from it "
+                    "(%.3g times its size, at most %g): the lens is nearly afocal", focus_mm,
+                    l->film_distance_mm, l->film_distance_mm / size, FILM_DISTANCE_MAX_RATIO);
+}
+
 static int setup_focus(camera *c, const camera_options *o, l2p_error *err)
 {
     lens *l = &c->lens;
@@ -95,6 +125,13 @@ static int setup_focus(camera *c, const camera_options *o, l2p_error *err)
         if (!(units > 0.0))
             return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--focus-distance must be positive");
         int st = focus_set(l, units * o->unit_mm, o->unit_mm, err);
+        if (!st)
+            st = check_film_position(l, false, units * o->unit_mm, err);
+        if (st)
+            return st;
+    }
+    if (!isnan(o->film_distance_mm)) {
+        int st = check_film_position(l, true, NAN, err);
         if (st)
             return st;
     }

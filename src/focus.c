@@ -45,7 +45,7 @@ static int thick_estimate(lens *l, double object_mm, double unit_mm, double *d, 
         return st;
     const double ff = t.front_focal_length_mm * t.rear_focal_length_mm;
     if (!(t.rear_focal_length_mm > 0.0))
-        return l2p_fail(err, L2P_BAD_INPUT, l->path, 0,
+        return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[0].line,
                         "the lens diverges light (focal length %g mm): it forms no real image",
                         t.rear_focal_length_mm);
     double e = 0.0;

@@ -63,7 +63,8 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err)
         out->ring_radius_mm[i] = out->radius_mm;
     out->ring_width_mm = 0.0;
     if (!(fabs(out->z_mm) > 1e-9 * (1.0 + out->radius_mm)) || !(out->radius_mm > 0.0))
-        return l2p_fail(err, L2P_BAD_INPUT, l->path, 0,
+        return l2p_fail(err, L2P_BAD_INPUT, l->path,
+                        l->surface[kind == PUPIL_REAR ? l->count - 1 : l->stop].line,
                         "the %s exit pupil lies in the film plane; choose another --pupil or "
                         "film distance", pupil_kind_name(kind));
     return L2P_OK;
