@@ -6,6 +6,11 @@
 #include "lens.h"
 #include "vec3.h"
 
+/* A refraction whose incidence or refraction cosine is below this counts as blocked: there the
+   direction's error grows like 1/cos and a ray traced back may no longer find its way, while
+   the light such rays carry (cos^4 weighted, at the rim of the bundle) is negligible. */
+#define TRACE_GRAZING_COS 1e-4
+
 typedef struct ray {
     vec3 o;  /* origin, camera space, mm */
     vec3 d;  /* unit direction */
@@ -16,7 +21,8 @@ typedef enum trace_status {
     TRACE_PASSED = 0,
     TRACE_MISSED,      /* no intersection with the surface's cap, or behind the ray */
     TRACE_CLIPPED,     /* outside a surface's clear aperture or the stop's opening */
-    TRACE_TIR          /* total internal reflection */
+    TRACE_TIR,         /* total internal reflection */
+    TRACE_GRAZING      /* refracted within a hair of grazing: see TRACE_GRAZING_COS */
 } trace_status;
 
 /* Intersects surface s (its vertex at s->vertex_z_mm) and moves r->o there. The cap is the

@@ -95,15 +95,16 @@ INLINE vd root_ok(vd t0, vd t, vd pz, vd dz, vd c)
     return and(and(ahead, finite), cap);
 }
 
-/* Status per lane: missed, clipped, totally reflected, or still passing; returns the mask of
-   lanes still passing. */
-INLINE vd update_status(long long *status, int hit, int inside, int tir)
+/* Status per lane: missed, clipped, totally reflected, grazing, or still passing; returns the
+   mask of lanes still passing. */
+INLINE vd update_status(long long *status, int hit, int inside, int tir, int grazing)
 {
     double ok[LANES];
     for (int i = 0; i < LANES; i++) {
         if (status[i] == TRACE_PASSED)
             status[i] = !(hit >> i & 1) ? TRACE_MISSED : !(inside >> i & 1) ? TRACE_CLIPPED
-                      : (tir >> i & 1) ? TRACE_TIR : TRACE_PASSED;
+                      : (tir >> i & 1) ? TRACE_TIR : (grazing >> i & 1) ? TRACE_GRAZING
+                      : TRACE_PASSED;
         const long long m = status[i] == TRACE_PASSED ? -1 : 0;
         memcpy(&ok[i], &m, sizeof m);
     }
@@ -156,10 +157,13 @@ static void cross_lanes(const lens_surface *s, double a2, double eta_s, double *
     const vd flip = pick(lt(cos_i0, splat(0)), splat(-1), one);
     const vd nx = mul(nx0, flip), ny = mul(ny0, flip), nz = mul(nz0, flip), cos_i = mul(cos_i0, flip);
     const vd sin2_t = mul(mul(eta, eta), sub(one, mul(cos_i, cos_i)));
-    const vd kk = sub(mul(eta, cos_i), vsqrt(vmax(sub(one, sin2_t), splat(0))));
+    const vd cos_t = vsqrt(vmax(sub(one, sin2_t), splat(0)));
+    const vd kk = sub(mul(eta, cos_i), cos_t);
+    const vd graze = splat(TRACE_GRAZING_COS);
     const int refracts = eta_s != 1;
     const vd ok = update_status(status, bits(hit), bits(le(add(mul(h[0], h[0]), mul(h[1], h[1])), splat(a2))),
-                                refracts ? bits(gt(sin2_t, one)) : 0);
+                                refracts ? bits(gt(sin2_t, one)) : 0,
+                                refracts ? bits(or(lt(cos_i, graze), lt(cos_t, graze))) : 0);
     store(o_at[0], pick(ok, h[0], o[0]));
     store(o_at[1], pick(ok, h[1], o[1]));
     store(o_at[2], pick(ok, add(h[2], splat(s->vertex_z_mm)), o[2]));

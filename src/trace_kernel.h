@@ -98,6 +98,8 @@ static inline __attribute__((always_inline)) trace_status KNAME(refract_eta)(KVE
     if (sin2_t > 1)
         return TRACE_TIR;
     const KREAL cos_t = sqrt(1 - sin2_t);
+    if (cos_i < (KREAL)TRACE_GRAZING_COS || cos_t < (KREAL)TRACE_GRAZING_COS)
+        return TRACE_GRAZING;
     const KREAL k = eta * cos_i - cos_t;
     d->x = eta * d->x + k * n.x;
     d->y = eta * d->y + k * n.y;
