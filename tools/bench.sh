@@ -36,10 +36,10 @@ median3() {
 
 echo "== lens2pov render against POV-Ray's perspective camera, same primary rays (median of 3)"
 W=320 H=240 SPP=16
-scene=pov/scene.pov
+scene=pov/bench.pov   # the bundled scene with soft shadows: real shading
 lens_t=$(median3 "$build/lens2pov" render "$scene" lenses/dgauss.50mm.dat --width $W --height $H \
     --spp $SPP --location 0,1.2,-4 --look-at 0,1,0 -o "$work/lens.png" --quiet)
-pov_t=$(median3 sh -c "cd pov && povray scene.pov +W$W +H$((H * SPP)) -A -D -V -GA +FE +O'$work/own.exr'")
+pov_t=$(median3 sh -c "cd pov && povray bench.pov +W$W +H$((H * SPP)) -A -D -V -GA +FE +O'$work/own.exr'")
 awk -v a="$lens_t" -v b="$pov_t" -v n=$((W * H * SPP)) 'BEGIN {
   printf "%d primary rays: lens2pov render %.2f s, povray perspective %.2f s, ratio %.2f (target <= 1.5)\n", n, a, b, a / b }'
 
