@@ -13,7 +13,7 @@ SAN      ?=
 LDLIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util) -lstdc++ -lm -lpthread
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
-               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev
+               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core
 
 LIB_C   = $(filter-out src/main.c,$(wildcard src/*.c))
 LIB_CXX = $(wildcard src/*.cpp)

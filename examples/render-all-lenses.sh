@@ -1,3 +1,206 @@
 #!/bin/sh
-echo "examples/render-all-lenses.sh: not written yet" >&2
-exit 0
+# Render a POV-Ray scene through every lens file, with each of the seed's three variants, and
+# assemble a labelled contact sheet (one row per lens, one column per variant).
+#
+#   examples/render-all-lenses.sh SCENE OUTDIR [lens2pov render options...]
+#
+# Writes OUTDIR/<lens>-rear-full.png, <lens>-stop-image-full.png, <lens>-stop-image-thick.png
+# and OUTDIR/contact-sheet.png. Extra options go to every `lens2pov render`.
+# Defaults, each used only when you give none of its kind:
+#   size      --width 320 --height 240 --spp 16
+#   placement the `location`, `look_at` and `sky` of the scene's first camera block when they
+#             are plain number vectors; otherwise lens2pov's default (at the origin, looking
+#             along +z): then pass --location and --look-at yourself.
+# Environment: LENS2POV (the binary; default build/lens2pov of this repo, else lens2pov on
+# PATH), LENS_DIR (default lenses/ of this repo), FONT (oiiotool font, default DejaVuSans).
+#
+# A failed render (for instance a lens that cannot focus as close as the look-at point) is
+# reported with its lens, variant and command line; the other renders still run, its tile in
+# the contact sheet says "failed", and the script exits 1 at the end. When every render of the
+# first two lenses fails, the scene or the options are wrong for all lenses: it stops there.
+set -u
+
+me=render-all-lenses.sh
+say() { printf '%s: %s\n' "$me" "$*" >&2; }
+die() { say "$*"; exit 2; }
+
+if [ $# -lt 2 ] || [ "$1" = -h ] || [ "$1" = --help ]; then
+    sed -n '2,/^set -u/{/^#/s/^# \{0,1\}//p}' "$0" >&2
+    exit 2
+fi
+scene=$1
+outdir=$2
+shift 2
+
+here=$(CDPATH='' cd -- "$(dirname -- "$0")" && pwd) || exit 2
+repo=$(dirname -- "$here")
+lens_dir=${LENS_DIR:-$repo/lenses}
+font=${FONT:-DejaVuSans}
+if [ -n "${LENS2POV:-}" ]; then
+    bin=$LENS2POV
+elif [ -x "$repo/build/lens2pov" ]; then
+    bin=$repo/build/lens2pov
+else
+    bin=$(command -v lens2pov) || die "no lens2pov: run make in $repo, put it on PATH or set LENS2POV"
+fi
+command -v oiiotool >/dev/null || die "oiiotool not found (Debian package openimageio-tools)"
+{ [ -f "$scene" ] && [ -r "$scene" ]; } || die "cannot read scene '$scene'"
+total=0
+for lens in "$lens_dir"/*.dat; do
+    [ -f "$lens" ] || die "no lens files (*.dat) in '$lens_dir'"
+    total=$((total + 3))
+done
+
+# Which kinds of options did the user give? (--opt VALUE and --opt=VALUE both count.)
+have_size='' have_place=''
+for a in "$@"; do
+    case $a in
+        --width | --width=* | --height | --height=*) have_size=1 ;;
+        --location | --location=* | --look-at | --look-at=*) have_place=1 ;;
+        -o | --output | --output=* | --pupil | --pupil=* | --trace | --trace=*)
+            die "$a is set by this script (it renders every variant into OUTDIR)" ;;
+    esac
+done
+
+# The first `camera { ... }` of the scene: location, look_at and sky when each is a literal
+# vector <x, y, z>. Anything that moves the camera otherwise (transforms, #declared vectors)
+# makes it give up, rather than guess a wrong placement.
+scene_camera() {
+    sed 's://.*$::' "$1" | tr '\n\t' '  ' | awk '
+    {
+        s = $0
+        if (!match(s, /(^|[^A-Za-z0-9_])camera[ ]*\{/)) exit
+        s = substr(s, RSTART + RLENGTH); depth = 1; body = ""
+        for (i = 1; i <= length(s) && depth > 0; i++) {
+            c = substr(s, i, 1)
+            if (c == "{") depth++
+            if (c == "}") depth--
+            if (depth > 0) body = body c
+        }
+        if (body ~ /(translate|rotate|scale|matrix|transform|[{])/) exit
+        num = "[ ]*[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?[ ]*"
+        vec = "<" num "," num "," num ">"
+        n = split("location look_at sky", key, " ")
+        split("--location --look-at --sky", opt, " ")
+        out = ""
+        for (k = 1; k <= n; k++) {
+            if (match(body, key[k] "[ ]*" vec)) {
+                v = substr(body, RSTART, RLENGTH)
+                sub(/^[a-z_]+[ ]*</, "", v); sub(/>$/, "", v); gsub(/ /, "", v)
+                out = out " " opt[k] " " v
+            } else if (body ~ key[k]) exit
+        }
+        if (out ~ /--location/ && out ~ /--look-at/) print out
+    }'
+}
+
+defaults=''
+[ -n "$have_size" ] || defaults='--width 320 --height 240 --spp 16'
+if [ -z "$have_place" ]; then
+    cam=$(scene_camera "$scene")
+    if [ -n "$cam" ]; then
+        say "camera from the scene:$cam"
+        defaults="$defaults$cam"
+    else
+        say "warning: no plain camera { location <..> look_at <..> } in $scene; lens2pov's default" \
+            "placement applies (origin, looking along +z): pass --location and --look-at"
+    fi
+fi
+# shellcheck disable=SC2086 # $defaults holds separate words without blanks or globs.
+set -- $defaults "$@"
+
+# The command line, quoted so that it can be pasted back into a shell.
+quoted() {
+    q=''
+    for a in "$@"; do
+        case $a in
+            '' | *[!A-Za-z0-9_./,=:+@%-]*) a="'$(printf '%s' "$a" | sed "s/'/'\\\\''/g")'" ;;
+        esac
+        q="$q $a"
+    done
+    printf '%s' "${q# }"
+}
+
+mkdir -p -- "$outdir" || die "cannot make folder '$outdir'"
+variants='rear-full stop-image-full stop-image-thick'
+lenses=0 done_ok=0 failed='' n=0
+for lens in "$lens_dir"/*.dat; do
+    name=$(basename -- "$lens" .dat)
+    lenses=$((lenses + 1))
+    for v in $variants; do
+        n=$((n + 1))
+        case $v in
+            rear-full) vopts='--pupil rear --trace full' ;;
+            stop-image-full) vopts='--pupil stop-image --trace full' ;;
+            stop-image-thick) vopts='--pupil stop-image --trace thick' ;;
+        esac
+        out=$outdir/$name-$v.png
+        # A stale picture from an earlier run must not stand in for a failed render.
+        rm -f -- "$out"
+        say "[$n/$total] $name $v -> $out"
+        # shellcheck disable=SC2086 # $vopts is four plain words.
+        if "$bin" render "$scene" "$lens" "$@" $vopts -o "$out"; then
+            done_ok=$((done_ok + 1))
+        else
+            st=$?
+            # shellcheck disable=SC2086
+            say "FAILED (exit $st): lens $name, variant $v: $(quoted "$bin" render "$scene" "$lens" "$@" $vopts -o "$out")"
+            failed="$failed $name/$v"
+        fi
+    done
+    if [ "$lenses" -ge 2 ] && [ "$done_ok" -eq 0 ]; then
+        die "every render of the first $lenses lenses failed: stopping (see the messages above)"
+    fi
+done
+
+# The contact sheet: a label column, a header row, and one 320x240 tile per render (fitted and
+# padded, so that any image size or aspect fits). oiiotool's --paste puts the image *below* the
+# top of the stack onto the top one, hence the --swap after each tile.
+tile_w=320 tile_h=240 gap=6 label_w=190 head_h=34
+sheet_w=$((label_w + 3 * (tile_w + gap)))
+sheet_h=$((head_h + lenses * (tile_h + gap)))
+text="--text:size=18:color=0.95,0.95,0.95:font=$font"
+contact_sheet() {
+    tmp=$outdir/contact-sheet.tmp$$.png
+    set -- --pattern constant:color=0.13,0.13,0.13 "${sheet_w}x$sheet_h" 3
+    col=0
+    for v in $variants; do
+        set -- "$@" "$text:x=$((label_w + col * (tile_w + gap) + 8)):y=24" "$v"
+        col=$((col + 1))
+    done
+    row=0
+    for lens in "$lens_dir"/*.dat; do
+        name=$(basename -- "$lens" .dat)
+        y=$((head_h + row * (tile_h + gap)))
+        set -- "$@" "$text:x=10:y=$((y + tile_h / 2))" "$name"
+        col=0
+        for v in $variants; do
+            x=$((label_w + col * (tile_w + gap)))
+            if [ -f "$outdir/$name-$v.png" ]; then
+                set -- "$@" "$outdir/$name-$v.png" --ch R,G,B --fit:pad=1 "${tile_w}x$tile_h"
+            else
+                set -- "$@" --pattern constant:color=0.35,0.08,0.08 "${tile_w}x$tile_h" 3 \
+                    "$text:x=110:y=$((tile_h / 2))" "render failed"
+            fi
+            set -- "$@" --swap --paste "+$x+$y"
+            col=$((col + 1))
+        done
+        row=$((row + 1))
+    done
+    if oiiotool "$@" -o "$tmp" && mv -f -- "$tmp" "$outdir/contact-sheet.png"; then
+        say "contact sheet: $outdir/contact-sheet.png"
+    else
+        rm -f -- "$tmp"
+        say "FAILED: the contact sheet (oiiotool; is the font '$font' installed? Debian: fonts-dejavu-core)"
+        return 1
+    fi
+}
+contact_sheet || failed="$failed contact-sheet"
+
+if [ -n "$failed" ]; then
+    say "$done_ok of $total renders done; failed:$failed"
+    say "(lens2pov's reason is above each FAILED line; a lens that cannot focus on the look-at" \
+        "point needs --focus-distance UNITS or --film-distance MM)"
+    exit 1
+fi
+say "$done_ok of $total renders done in $outdir"
