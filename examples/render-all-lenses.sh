@@ -66,7 +66,7 @@ done
 # vector <x, y, z>. Anything that moves the camera otherwise (transforms, #declared vectors)
 # makes it give up, rather than guess a wrong placement.
 scene_camera() {
-    sed 's://.*$::' "$1" | tr '\n\t' '  ' | awk '
+    sed 's://.*$::' "$1" | tr '\n\t\r' '   ' | awk '
     {
         s = $0
         if (!match(s, /(^|[^A-Za-z0-9_])camera[ ]*\{/)) exit

@@ -151,6 +151,7 @@ for lens in lenses/*.dat; do
 done
 mv "$work/e.csv" "$csv"
 mv "$work/r.csv" "$ray_csv"
+cp "$work/b.csv" "$out/brightness.csv"
 
 # The figure: one panel per lens, one colour per variant, log-log.
 n=$(find lenses -name '*.dat' | wc -l)
@@ -225,7 +226,8 @@ END {
     printf "Scene `%s` (%s), %dx%d pixels, %s samples per pixel; lens2pov binary sha256 %s.\n", scene, camera, W, H, spps, version
     print "Every image error is the RMSE over all pixels and RGB channels, in linear EXR values, against"
     printf "a reference rendered with the full simulation and the stop-image pupil at %d spp (another\n", ref_spp
-    print "seed), cached in `cache/`. Data: `error-vs-time.csv`, `thick-lens-ray-error.csv`; the figure is"
+    print "seed), cached in `cache/`. Data: `error-vs-time.csv`, `thick-lens-ray-error.csv`,"
+    print "`brightness.csv` (mean of each variant'\''s " hi "-spp picture and of the reference); the figure is"
     print "drawn by `error-vs-time.gp`."
     print ""
     print "![RMSE against wall time](error-vs-time.png)"
@@ -253,7 +255,7 @@ END {
         else if (thick_wins[l] == budgets[l])
             printf "- %s: stop-image-thick gives the lowest error at every time budget measured.\n", l
         else if (full_first[l] + 0 < thick_last[l] + 0)
-            printf "- %s: stop-image-thick gives the lowest error at %d of the %d time budgets below, the full simulation at the others: no floor shows here.\n", l, thick_wins[l], budgets[l]
+            printf "- %s: stop-image-thick gives the lowest error at %d of the %d time budgets tried, the full simulation at the others: no floor shows here.\n", l, thick_wins[l], budgets[l]
         else
             printf "- %s: stop-image-thick wins only with %s s or less; from %s s on the full simulation (%s) wins.\n", l, thick_last[l], full_first[l], full_best[l]
     }
@@ -340,7 +342,9 @@ END {
     if (worst > 0.8) printf "  floor against it. It does, on %s (RMSE(%d)/RMSE(%d) = %.2f): look there.\n", wl, hi, prev, worst
     else printf "  floor against it; it does not (its RMSE(%d)/RMSE(%d) is at most %.2f, on %s).\n", hi, prev, worst, wl
     print "- lens2pov writes half-float EXR: values carry about 3 significant digits, far below these errors."
-    print "- Wall times are of one run each on a machine that may be shared: read them to about 10-20%."
+    print "- Wall times are of one run each. On a machine shared with other work they varied by up to"
+    print "  a factor of 2 between repeats of this report, which can swap the budget winners where two"
+    print "  curves lie close together (rear-full and stop-image-full on dgauss and the fisheye)."
 }' "$csv" "$ray_csv" "$work/b.csv" >"$work/README.md"
 mv "$work/README.md" "$out/README.md"
 say "done in ${elapsed}s: $out/README.md, $csv, $out/error-vs-time.png, $ray_csv"
