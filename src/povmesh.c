@@ -3,6 +3,7 @@
 #include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "outfile.h"
 #include "samplemap.h"
 
@@ -233,9 +234,22 @@ static void put_camera(text_out *t, const povmesh_emitter *e)
         e->decimals, w.x, w.y, w.z);
 }
 
+/* The render's name, absolute: POV-Ray is run in the scene's folder, not in ours. */
+static char *absolute_exr_path(const povmesh_emitter *e, int index)
+{
+    char *exr = chunk_path(e, index, "exr"), cwd[4096];
+    if (!exr || exr[0] == '/' || !getcwd(cwd, sizeof cwd))
+        return exr;
+    char *abs = malloc(strlen(cwd) + strlen(exr) + 2);
+    if (abs)
+        sprintf(abs, "%s/%s", cwd, exr);
+    free(exr);
+    return abs;
+}
+
 static int write_ini(povmesh_emitter *e, chunk *ch, int index, long long rows, l2p_error *err)
 {
-    char *path = chunk_path(e, index, "ini"), *exr = chunk_path(e, index, "exr");
+    char *path = chunk_path(e, index, "ini"), *exr = absolute_exr_path(e, index);
     int st = path && exr ? outfile_open(&ch->ini, path, err)
                          : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     if (!st)
