@@ -152,7 +152,7 @@ Test(trace, apertures_clip)
    including blocked and odd-sized batches. */
 #include "trace_batch.h"
 
-Test(trace, batch_and_single_ray_agree_bit_for_bit)
+static void check_batch_against_kernel(void)
 {
     const char *names[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm", "telephoto.250mm"};
     const double film[] = {36.77, 14.54, 23.192, 123.7439};
@@ -181,16 +181,32 @@ Test(trace, batch_and_single_ray_agree_bit_for_bit)
         int passed = 0;
         for (int k = 0; k < n; k++) {
             const trace_status st = trace_toward_scene(&l, 0, l.count - 1, &single[k], NULL);
-            cr_assert_eq(b.status[k], st, "%s ray %d: status %lld against %d", names[li], k, b.status[k], st);
+            cr_assert_eq(b.status[k], st, "%s, %s ray %d: status %lld against %d", trace_soa_isa(), names[li], k, b.status[k], st);
             if (st != TRACE_PASSED)
                 continue;
             passed++;
             const double got[6] = {b.ox[k], b.oy[k], b.oz[k], b.dx[k], b.dy[k], b.dz[k]};
             const double want[6] = {single[k].o.x, single[k].o.y, single[k].o.z,
                                     single[k].d.x, single[k].d.y, single[k].d.z};
-            cr_assert(memcmp(got, want, sizeof got) == 0, "%s ray %d differs", names[li], k);
+            cr_assert(memcmp(got, want, sizeof got) == 0, "%s, %s ray %d differs", trace_soa_isa(), names[li], k);
         }
         cr_assert(passed > 0 && passed < n, "%s: %d of %d pass; both kinds must be covered", names[li], passed, n);
         lens_free(&l);
     }
+}
+
+/* Each instruction set this processor has (the best is the default). */
+Test(trace, batch_and_single_ray_agree_bit_for_bit)
+{
+    const char *isas[] = {"avx512", "avx2", "sse2", "scalar"};
+    int tried = 0;
+    for (int i = 0; i < 4; i++) {
+        if (trace_soa_use_isa(isas[i]) != 0)
+            continue;
+        cr_assert_str_eq(trace_soa_isa(), isas[i]);
+        check_batch_against_kernel();
+        tried++;
+    }
+    cr_assert(tried >= 1 && trace_soa_use_isa("scalar") == 0, "the one-ray kernel is always there");
+    cr_assert_eq(trace_soa_use_isa("avx1024"), -1, "an unknown name is refused");
 }

@@ -1,0 +1,93 @@
+/* The vector primitives of trace_lanes.h for SSE2 and AVX: VECS registers of WIDTH doubles,
+   masks kept as all-ones or all-zero doubles. The includer defines
+     VECS, WIDTH, reg    register count, doubles a register, the register type
+     R(op)               the intrinsic _mm_<op>_pd or _mm256_<op>_pd
+     CMP_LT .. CMP_NE    the comparisons (ordered, but for != as in C), mask results
+     INLINE              always inline, with the instruction set's target attribute */
+#include <stdint.h>
+
+#define LANES (VECS * WIDTH)
+typedef struct vd { reg p[VECS]; } vd;
+typedef vd vm;
+
+#define UNROLL _Pragma("GCC unroll 4")
+#define BINARY(name, expr)                                                                \
+    INLINE vd name(vd a, vd b)                                                            \
+    {                                                                                     \
+        vd r;                                                                             \
+        UNROLL for (int i = 0; i < VECS; i++) r.p[i] = expr(a.p[i], b.p[i]);              \
+        return r;                                                                         \
+    }
+BINARY(add, R(add))
+BINARY(sub, R(sub))
+BINARY(mul, R(mul))
+BINARY(dvd, R(div))
+BINARY(vand, R(and))
+BINARY(vor, R(or))
+BINARY(vandnot, R(andnot))
+BINARY(vmax, R(max))
+BINARY(lt, CMP_LT)
+BINARY(le, CMP_LE)
+BINARY(gt, CMP_GT)
+BINARY(ge, CMP_GE)
+BINARY(ne, CMP_NE)
+
+INLINE vd splat(double x)
+{
+    vd r;
+    UNROLL for (int i = 0; i < VECS; i++) r.p[i] = R(set1)(x);
+    return r;
+}
+
+INLINE vd vsqrt(vd a)
+{
+    vd r;
+    UNROLL for (int i = 0; i < VECS; i++) r.p[i] = R(sqrt)(a.p[i]);
+    return r;
+}
+
+INLINE vd load(const double *x)
+{
+    vd r;
+    UNROLL for (int i = 0; i < VECS; i++) r.p[i] = R(loadu)(x + WIDTH * i);
+    return r;
+}
+
+INLINE void store(double *x, vd v)
+{
+    UNROLL for (int i = 0; i < VECS; i++) R(storeu)(x + WIDTH * i, v.p[i]);
+}
+
+INLINE unsigned bits(vm m)
+{
+    unsigned r = 0;
+    UNROLL for (int i = 0; i < VECS; i++) r |= (unsigned)R(movemask)(m.p[i]) << (WIDTH * i);
+    return r;
+}
+
+/* Row m: lane j all ones when bit j of m is set. */
+static const uint64_t lane_masks[1 << WIDTH][WIDTH] __attribute__((aligned(32))) = {
+#if WIDTH == 2
+    {0, 0}, {~0ull, 0}, {0, ~0ull}, {~0ull, ~0ull}
+#else
+    {0, 0, 0, 0}, {~0ull, 0, 0, 0}, {0, ~0ull, 0, 0}, {~0ull, ~0ull, 0, 0},
+    {0, 0, ~0ull, 0}, {~0ull, 0, ~0ull, 0}, {0, ~0ull, ~0ull, 0}, {~0ull, ~0ull, ~0ull, 0},
+    {0, 0, 0, ~0ull}, {~0ull, 0, 0, ~0ull}, {0, ~0ull, 0, ~0ull}, {~0ull, ~0ull, 0, ~0ull},
+    {0, 0, ~0ull, ~0ull}, {~0ull, 0, ~0ull, ~0ull}, {0, ~0ull, ~0ull, ~0ull}, {~0ull, ~0ull, ~0ull, ~0ull}
+#endif
+};
+
+INLINE vm mask_of(unsigned lanes)
+{
+    vm r;
+    UNROLL for (int i = 0; i < VECS; i++)
+        r.p[i] = R(load)((const double *)lane_masks[lanes >> (WIDTH * i) & ((1 << WIDTH) - 1)]);
+    return r;
+}
+
+INLINE vm mand(vm a, vm b) { return vand(a, b); }
+INLINE vm mor(vm a, vm b) { return vor(a, b); }
+INLINE vd pick(vm m, vd a, vd b) { return vor(vand(m, a), vandnot(m, b)); }
+INLINE vd neg(vd x) { return sub(splat(0), x); }
+INLINE vd vabs(vd x) { return vandnot(splat(-0.0), x); }
+INLINE vd vcopysign(vd x, vd y) { return vor(vandnot(splat(-0.0), x), vand(splat(-0.0), y)); }
