@@ -10,14 +10,22 @@ OPT      ?= -O2
 CFLAGS_BASE   = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE $(OPT) -g -fno-math-errno -Wall -Wextra -Werror
 CXXFLAGS_BASE = -std=c++17 $(OPT) -g -Wall -Wextra -Werror
 SAN      ?=
-LDLIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util) -lstdc++ -lm -lpthread
+LDLIBS   = -lm -lpthread -ldl
+OIIO_CFLAGS = $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
+OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util)
+# OpenImageIO is not linked into the executables: src/image_io.cpp alone becomes
+# lens2pov-image-io.so beside them, which src/image_io_loader.c dlopen()s on the first image read
+# or write (`info` and `trace` never load it). The library calls back into the executable for
+# these three functions, so every executable that may load it exports them.
+IMAGE_IO_SO    = $(BUILD)/lens2pov-image-io.so
+IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbol=outfile_track \
+                 -Wl,--export-dynamic-symbol=outfile_untrack
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
                pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core
 
 LIB_C   = $(filter-out src/main.c,$(wildcard src/*.c))
-LIB_CXX = $(wildcard src/*.cpp)
-LIB_OBJ = $(LIB_C:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/obj/%.o)
+LIB_OBJ = $(LIB_C:src/%.c=$(BUILD)/obj/%.o)
 TEST_C  = $(wildcard tests/*.c)
 TEST_OBJ = $(TEST_C:tests/%.c=$(BUILD)/tobj/%.o)
 
@@ -32,8 +40,9 @@ deps:
 $(BUILD)/obj/%.o: src/%.c $(wildcard src/*.h) | $(BUILD)/obj
 	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -c $< -o $@
 
+# The only C++ (src/image_io.cpp) goes into the shared library only, hence -fPIC.
 $(BUILD)/obj/%.o: src/%.cpp $(wildcard src/*.h) | $(BUILD)/obj
-	$(CXX) $(CXXFLAGS_BASE) $(SAN) $(CXXFLAGS) $(shell pkg-config --cflags OpenImageIO 2>/dev/null) -c $< -o $@
+	$(CXX) $(CXXFLAGS_BASE) $(SAN) $(CXXFLAGS) -fPIC $(OIIO_CFLAGS) -c $< -o $@
 
 $(BUILD)/tobj/%.o: tests/%.c $(wildcard src/*.h tests/*.h) | $(BUILD)/tobj
 	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -Isrc -DLENS2POV_SOURCE_DIR='"$(CURDIR)"' -c $< -o $@
@@ -41,11 +50,15 @@ $(BUILD)/tobj/%.o: tests/%.c $(wildcard src/*.h tests/*.h) | $(BUILD)/tobj
 $(BUILD)/liblens2pov.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/lens2pov: $(BUILD)/obj/main.o $(BUILD)/liblens2pov.a
-	$(CC) $(SAN) $^ -o $@ $(LDLIBS)
+$(IMAGE_IO_SO): $(BUILD)/obj/image_io.o
+	$(CXX) $(SAN) -shared $^ -o $@ $(OIIO_LIBS)
 
-$(BUILD)/run_tests: $(TEST_OBJ) $(BUILD)/liblens2pov.a
-	$(CC) $(SAN) $^ -o $@ -lcriterion $(LDLIBS)
+# Order-only: the library is loaded at run time, a new one needs no relink.
+$(BUILD)/lens2pov: $(BUILD)/obj/main.o $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
+	$(CC) $(SAN) $(IMAGE_IO_HOST) $^ -o $@ $(LDLIBS)
+
+$(BUILD)/run_tests: $(TEST_OBJ) $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
+	$(CC) $(SAN) $(IMAGE_IO_HOST) $^ -o $@ -lcriterion $(LDLIBS)
 
 $(BUILD)/obj $(BUILD)/tobj:
 	mkdir -p $@
@@ -93,9 +106,13 @@ fuzz: deps
 valgrind: deps $(BUILD)/lens2pov
 	sh tools/valgrind.sh $(BUILD)/lens2pov
 
+# The image library goes to PREFIX/lib/lens2pov/, where lens2pov looks for it (../lib/lens2pov
+# from its own folder) when it is not beside it.
 install: $(BUILD)/lens2pov
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/lens2pov/lenses $(DESTDIR)$(PREFIX)/share/lens2pov/pov
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/lens2pov \
+	  $(DESTDIR)$(PREFIX)/share/lens2pov/lenses $(DESTDIR)$(PREFIX)/share/lens2pov/pov
 	install -m 755 $(BUILD)/lens2pov $(DESTDIR)$(PREFIX)/bin/lens2pov
+	install -m 644 $(IMAGE_IO_SO) $(DESTDIR)$(PREFIX)/lib/lens2pov/lens2pov-image-io.so
 	install -m 644 lenses/*.dat $(DESTDIR)$(PREFIX)/share/lens2pov/lenses
 	install -m 644 pov/* $(DESTDIR)$(PREFIX)/share/lens2pov/pov
 

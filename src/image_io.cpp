@@ -1,6 +1,8 @@
 // Images through OpenImageIO 2.4, which has only a C++ API: the rest of lens2pov is C and calls
-// the extern "C" functions of image_io.h. No exception may cross into C, so every entry point
-// catches everything and turns it into an l2p_error.
+// the extern "C" functions of image_io.h. This file alone is built into lens2pov-image-io.so,
+// which image_io_loader.c loads on first use (OpenImageIO's libraries cost 0.3 s at start-up);
+// the .so exports those functions as image_io_impl_* (image_io_impl.h). No exception may cross
+// into C, so every entry point catches everything and turns it into an l2p_error.
 //
 // Colour encoding is done here with the exact sRGB transfer function of IEC 61966-2-1 (the
 // piecewise curve with the linear toe), not with ImageBufAlgo::colorconvert: that one depends on
@@ -11,7 +13,7 @@ extern "C" {
 #include "error.h"
 #include "outfile.h"
 }
-#include "image_io.h"
+#include "image_io_impl.h"
 
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/strutil.h>
@@ -400,8 +402,8 @@ int caught(l2p_error *err, const char *path)
 
 }  // namespace
 
-extern "C" int image_read_rgba(const char *path, int *width, int *height, float **pixels,
-                               l2p_error *err)
+extern "C" int image_io_impl_read_rgba(const char *path, int *width, int *height,
+                                       float **pixels, l2p_error *err)
 {
     try {
         return read_rgba(path, width, height, pixels, err);
@@ -410,9 +412,9 @@ extern "C" int image_read_rgba(const char *path, int *width, int *height, float 
     }
 }
 
-extern "C" int image_write_rgb(const char *path, int width, int height, const float *pixels,
-                               const image_attribute *attributes, int attribute_count,
-                               l2p_error *err)
+extern "C" int image_io_impl_write_rgb(const char *path, int width, int height,
+                                       const float *pixels, const image_attribute *attributes,
+                                       int attribute_count, l2p_error *err)
 {
     try {
         return write_rgb(path, width, height, pixels, attributes, attribute_count, err);
@@ -421,7 +423,8 @@ extern "C" int image_write_rgb(const char *path, int width, int height, const fl
     }
 }
 
-extern "C" int image_get_attribute(const char *path, const char *name, char *buf, size_t len)
+extern "C" int image_io_impl_get_attribute(const char *path, const char *name, char *buf,
+                                           size_t len)
 {
     try {
         std::string value;

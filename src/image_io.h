@@ -1,4 +1,6 @@
-/* Images through OpenImageIO; the only C++ of the project is behind these functions. */
+/* Images through OpenImageIO; the only C++ of the project is behind these functions. It is
+   built into lens2pov-image-io.so, loaded on the first call (image_io_loader.c); when that
+   library cannot be loaded, every function returns L2P_FAILED, err naming the paths tried. */
 #ifndef LENS2POV_IMAGE_IO_H
 #define LENS2POV_IMAGE_IO_H
 

@@ -31,9 +31,10 @@ started=$(date +%s)
 
 # A private copy: others may rebuild build/lens2pov while this runs, and its hash is the
 # "lens2pov version" of the cache key (there is no --version; the binary changes with the code).
-cp "$build/lens2pov" "$work/lens2pov"
+# The image library goes beside it, where lens2pov looks for it, and into the hash.
+cp "$build/lens2pov" "$build/lens2pov-image-io.so" "$work/"
 bin=$work/lens2pov
-version=$(sha256sum "$bin" | cut -c1-12)
+version=$(cat "$bin" "$work/lens2pov-image-io.so" | sha256sum | cut -c1-12)
 # References of other lens2pov builds will not be used again.
 find "$cache" -name 'ref-*.exr' ! -name "*-$version.exr" -exec rm -f {} +
 scene_key=$(printf '%s\n' "$camera" | cat "$scene" - | sha256sum | cut -c1-12)

@@ -2,10 +2,11 @@
 # make valgrind: lens2pov under valgrind's memcheck on small runs: info, a trace (with the
 # CSV), a refused lens (the error path) and a whole render (trace, POV-Ray runner, develop);
 # VALGRIND_ALL=1 adds info with a camera, a thick trace, a refused option and develop on its
-# own (each run costs some 10 s: valgrind reads OpenImageIO's libraries). Fails (exit 1) on any memory error
-# and on any definite or indirect leak; "still reachable" blocks (OpenImageIO's and the C++
-# runtime's caches, freed by the system at exit) and "possibly lost" ones (thread stacks) do
-# not count. POV-Ray itself runs outside valgrind.
+# own (develop and render cost some 10 s each: valgrind reads the OpenImageIO libraries that
+# they alone load). Fails (exit 1) on any memory error and on any definite or indirect leak;
+# "still reachable" blocks (OpenImageIO's and the C++ runtime's caches, freed by the system at
+# exit) and "possibly lost" ones (thread stacks) do not count, nor does glibc's own loss while
+# loading OpenImageIO (tools/valgrind.supp). POV-Ray itself runs outside valgrind.
 set -eu
 bin=${1:-build/lens2pov}
 case $bin in /*) ;; *) bin=$(pwd)/$bin ;; esac
@@ -21,8 +22,9 @@ run() {
     shift 2
     log=$work/valgrind.$(echo "$what" | tr -c 'a-z0-9\n' '-').log
     set +e
-    valgrind --error-exitcode=99 --leak-check=full --show-leak-kinds=definite,indirect \
-        --errors-for-leak-kinds=definite,indirect --track-origins=yes --num-callers=30 \
+    valgrind --error-exitcode=99 --suppressions="$root/tools/valgrind.supp" --leak-check=full \
+        --show-leak-kinds=definite,indirect --errors-for-leak-kinds=definite,indirect \
+        --track-origins=yes --num-callers=30 \
         --log-file="$log" "$bin" "$@" >"$work/out" 2>"$work/err"
     got=$?
     set -e
