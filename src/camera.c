@@ -174,9 +174,9 @@ static int setup_weights(camera *c, weighting w, l2p_error *err)
         return L2P_OK;
     const double mean = centre_mean_weight(c);
     if (!(mean > 0.0))
-        return l2p_fail(err, L2P_BAD_INPUT, c->lens.path, 0,
-                        "the lens blocks every ray at the film centre: nothing to normalize "
-                        "against (use --weighting physical)");
+        return l2p_fail(err, L2P_BAD_INPUT, c->lens.path, c->lens.surface[c->lens.stop].line,
+                        "with this stop, the lens blocks every ray at the film centre: nothing "
+                        "to normalize against (use --weighting physical)");
     c->weight_scale = 1.0 / mean;
     return L2P_OK;
 }

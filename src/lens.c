@@ -208,10 +208,11 @@ static int note_stop(const where *w, lens *l)
     return L2P_OK;
 }
 
-/* Reads every line into l->surface. Line numbers count '\n's, so they match what an editor
-   shows for LF and CRLF files alike. */
+/* Reads every line into l->surface; *last_line is the number of the last line (1 for an
+   empty file). Line numbers count '\n's, so they match what an editor shows for LF and CRLF
+   files alike. */
 static int parse_rows(const char *text, size_t length, const char *path, lens *l,
-                      l2p_error *err)
+                      int *last_line, l2p_error *err)
 {
     const char *p = text, *end = text + length;
     /* Editors on Windows may start a UTF-8 file with a byte order mark. */
@@ -237,16 +238,20 @@ static int parse_rows(const char *text, size_t length, const char *path, lens *l
             return st;
         p = eol < end ? eol + 1 : end;
     }
+    *last_line = w.line > 0 ? w.line : 1;
     return L2P_OK;
 }
 
-/* What the rows must make together: at least one surface, one stop, one refracting surface. */
-static int check_lens(const lens *l, l2p_error *err)
+/* What the rows must make together: at least one surface, one stop, one refracting surface.
+   What is missing is found missing at the end of the file, so that is the line named. */
+static int check_lens(const lens *l, int last_line, l2p_error *err)
 {
     if (l->count == 0)
-        return l2p_fail(err, L2P_BAD_INPUT, l->path, 0, "no surfaces");
+        return l2p_fail(err, L2P_BAD_INPUT, l->path, last_line,
+                        "no surfaces by the end of the file (a row is 4 numbers)");
     if (l->stop < 0)
-        return l2p_fail(err, L2P_BAD_INPUT, l->path, 0, "no aperture stop (a row with radius 0)");
+        return l2p_fail(err, L2P_BAD_INPUT, l->path, last_line,
+                        "no aperture stop (a row with radius 0) by the end of the file");
     if (l->count == 1)
         return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[0].line,
                         "no refracting surface, only the aperture stop");
@@ -271,11 +276,12 @@ static char *lens_name_of(const char *path)
 
 /* The parse with strtod in the "C" locale whatever the process's locale is (a library may
    have called setlocale): lens files always write a decimal point. uselocale is per thread. */
-static int parse_in_c_locale(const char *text, size_t length, lens *l, l2p_error *err)
+static int parse_in_c_locale(const char *text, size_t length, lens *l, int *last_line,
+                             l2p_error *err)
 {
     locale_t c_locale = newlocale(LC_ALL_MASK, "C", (locale_t)0);
     locale_t previous = c_locale ? uselocale(c_locale) : (locale_t)0;
-    int st = parse_rows(text, length, l->path, l, err);
+    int st = parse_rows(text, length, l->path, l, last_line, err);
     if (c_locale) {
         uselocale(previous);
         freelocale(c_locale);
@@ -294,10 +300,11 @@ int lens_parse(const char *text, size_t length, const char *name, lens *out, l2p
     l.path = strdup(name ? name : "(lens)");
     l.name = l.path ? lens_name_of(l.path) : NULL;
     int st = l.name ? L2P_OK : out_of_memory(err);
+    int last_line = 1;
     if (!st)
-        st = parse_in_c_locale(text, length, &l, err);
+        st = parse_in_c_locale(text, length, &l, &last_line, err);
     if (!st)
-        st = check_lens(&l, err);
+        st = check_lens(&l, last_line, err);
     if (st) {
         lens_free(&l);
         return st;

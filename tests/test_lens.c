@@ -219,7 +219,7 @@ Test(lens, hemisphere_is_allowed)
 
 Test(lens, no_stop)
 {
-    REFUSED(FRONT REAR, 0, "no aperture stop");
+    REFUSED(FRONT REAR, 2, "no aperture stop (a row with radius 0) by the end of the file");
 }
 
 Test(lens, two_stops)
@@ -235,14 +235,14 @@ Test(lens, only_the_stop)
 
 Test(lens, no_surfaces)
 {
-    REFUSED("", 0, "no surfaces");
-    REFUSED("# just\n# comments\n", 0, "no surfaces");
-    REFUSED("\n\n  \t \r\n\r\n", 0, "no surfaces");
-    REFUSED("# no final newline", 0, "no surfaces");
+    REFUSED("", 1, "no surfaces by the end of the file");
+    REFUSED("# just\n# comments\n", 2, "no surfaces");
+    REFUSED("\n\n  \t \r\n\r\n", 4, "no surfaces");
+    REFUSED("# no final newline", 1, "no surfaces");
     lens l;
     l2p_error err = {0};
     cr_assert_eq(lens_parse(NULL, 0, "lenses/bad.dat", &l, &err), L2P_BAD_INPUT);
-    cr_assert_str_eq(err.text, "lenses/bad.dat: no surfaces");
+    cr_assert_str_eq(err.text, "lenses/bad.dat:1: no surfaces by the end of the file (a row is 4 numbers)");
 }
 
 Test(lens, too_many_rows)
@@ -565,7 +565,7 @@ Test(lens, read_empty_file)
     l2p_error err = {0};
     cr_assert_eq(lens_read(path, &l, &err), L2P_BAD_INPUT);
     char expected[128];
-    snprintf(expected, sizeof expected, "%s: no surfaces", path);
+    snprintf(expected, sizeof expected, "%s:1: no surfaces by the end of the file (a row is 4 numbers)", path);
     cr_assert_str_eq(err.text, expected);
     unlink(path);
 }

@@ -219,9 +219,9 @@ typedef struct bad_lens {
 } bad_lens;
 
 static const bad_lens BAD_LENSES[] = {
-    {"", 0, 0, "no surfaces"},
-    {"# nothing but a comment\n\n", 0, 0, "no surfaces"},
-    {"50 5 1.5 20\n-50 0 1 20\n", 0, 0, "no aperture stop"},
+    {"", 0, 1, "no surfaces"},
+    {"# nothing but a comment\n\n", 0, 2, "no surfaces"},
+    {"50 5 1.5 20\n-50 0 1 20\n", 0, 2, "no aperture stop"},
     {"0 5 0 10\n", 0, 1, "only the aperture stop"},
     {"50 5 1.5\n0 5 0 10\n-50 0 1 20\n", 0, 1, "expected 4 numbers"},
     {"50 5 1.5 20 7\n0 5 0 10\n-50 0 1 20\n", 0, 1, "after the 4 numbers"},
