@@ -308,10 +308,10 @@ static void choose_layout(povmesh_emitter *e, long long chunk_faces)
                            c->samples.spp;
     e->packed_width = most < MAX_PACKED_WIDTH ? (int)(most > 0 ? most : 1) : MAX_PACKED_WIDTH;
     e->chunk_faces = 0;
-    if (chunk_faces > 0) {
-        long long rows = chunk_faces / e->packed_width;
-        e->chunk_faces = (rows > 0 ? rows : 1) * e->packed_width;
-    }
+    /* Whole packed rows, rounded up: a chunk size the caller computed as an equal share of the
+       faces must not leave a few hundred faces over for a chunk of their own. */
+    if (chunk_faces > 0)
+        e->chunk_faces = (chunk_faces + e->packed_width - 1) / e->packed_width * e->packed_width;
 }
 
 static void free_emitter(povmesh_emitter *e)

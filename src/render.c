@@ -37,18 +37,17 @@ static int number_of_cores(void)
     return n > 0 ? (int)n : 1;
 }
 
-/* Chunks small enough for the memory budget, as many as a multiple of the jobs and of about
-   the same size, so that the parses, which POV-Ray does on one thread, run side by side and
-   end together (3 chunks on 2 jobs would take two rounds for one and a half chunks' work). */
+/* Chunks small enough for the memory budget, as many as a multiple of the jobs and with the
+   same number of faces, so that the parses, which POV-Ray does on one thread, run side by side
+   and end together (3 chunks on 2 jobs would take two rounds for one and a half chunks' work). */
 static long long chunk_faces_for(const camera *cam, const cli *c, int jobs)
 {
     const long long budget = raytable_faces_for_memory(c->memory_mb);
-    const long long most = (long long)(cam->crop_x1 - cam->crop_x0) *
-                           (cam->crop_y1 - cam->crop_y0) * cam->samples.spp;
-    const long long needed = budget > 0 ? (most + budget - 1) / budget : 1;
-    const long long chunks = (needed + jobs - 1) / jobs * jobs;
-    const long long faces = (most + chunks - 1) / chunks;
-    return faces > 0 ? faces : 1;
+    const long long faces = raytable_count_faces(cam);
+    const long long needed = (faces + budget - 1) / budget;
+    const long long chunks = needed < 1 ? jobs : (needed + jobs - 1) / jobs * jobs;
+    const long long per_chunk = (faces + chunks - 1) / chunks;
+    return per_chunk > 0 ? per_chunk : 1;
 }
 
 typedef struct workspace {

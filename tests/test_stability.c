@@ -983,6 +983,55 @@ static int count_files_ending(const char *dir, const char *suffix)
     return n;
 }
 
+/* Faces in a chunk's include ("face_indices { N"). */
+static long long faces_in(const char *include_path)
+{
+    char *text = read_text(include_path, NULL);
+    cr_assert_not_null(text, "%s", include_path);
+    const char *at = strstr(text, "face_indices {");
+    cr_assert_not_null(at, "%s has no face_indices", include_path);
+    const long long n = atoll(at + strlen("face_indices {"));
+    free(text);
+    return n;
+}
+
+/* The wide angle vignettes: cutting by samples would give the corner rows' chunk fewer faces.
+   Two jobs get two chunks that together hold every ray the lens passes (the CSV of the same
+   trace); the first is half of them rounded up to whole packed rows of 1024 faces, so the two
+   differ by less than two rows (cutting by samples gave 12,288 and 7,129 faces). */
+Test(stability, chunks_share_the_faces_equally_between_jobs)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], image[512], keep[512], csv[512], prefix[512];
+    snprintf(scene, sizeof scene, "%s/tiny.pov", dir);
+    snprintf(image, sizeof image, "%s/two.exr", dir);
+    snprintf(keep, sizeof keep, "%s/keep", dir);
+    snprintf(csv, sizeof csv, "%s/rays.csv", dir);
+    snprintf(prefix, sizeof prefix, "%s/rays", dir);
+    write_text(scene, TINY_SCENE);
+    char *errtext = NULL;
+    const char *camera[] = {"--width", "96", "--height", "64", "--spp", "4", "--look-at", "0,0,3"};
+    int st = run_lens2pov(NULL, &errtext, "render", scene, LENS_DIR "wide.22mm.dat", camera[0],
+                          camera[1], camera[2], camera[3], camera[4], camera[5], camera[6],
+                          camera[7], "--jobs", "2", "--keep-temp", keep, "-o", image, "--quiet",
+                          NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    free(errtext);
+    st = run_lens2pov(NULL, &errtext, "trace", LENS_DIR "wide.22mm.dat", camera[0], camera[1],
+                      camera[2], camera[3], camera[4], camera[5], camera[6], camera[7], "--rays",
+                      csv, "-o", prefix, "--quiet", NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    free(errtext);
+    size_t passed;
+    free(read_rays_csv(csv, &passed));
+    cr_assert_eq(count_files_ending(keep, ".inc"), 2, "one chunk per job");
+    const long long a = faces_in(tmp_path(keep, "rays.c000.inc"));
+    const long long b = faces_in(tmp_path(keep, "rays.c001.inc"));
+    cr_assert_eq(a + b, (long long)passed, "%lld + %lld faces, %zu rays pass", a, b, passed);
+    cr_assert(passed < 96 * 64 * 4 * 0.9, "the lens vignettes: %zu of %d pass", passed, 96 * 64 * 4);
+    cr_assert(a >= b && a - b < 2048, "chunks of %lld and %lld faces", a, b);
+}
+
 Test(stability, ray_table_too_large_for_one_povray_process)
 {
     const char *dir = test_tmpdir();
