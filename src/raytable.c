@@ -127,9 +127,8 @@ static int append_row(povmesh_emitter *e, const row_out *o, raytable_stats *stat
     return L2P_OK;
 }
 
-/* The workers and the writer share a ring of row slots. */
-enum { SLOT_FREE, SLOT_BUSY, SLOT_READY };
-
+/* The workers and the writer share a ring of row slots: row py uses slot
+   (py - first_row) % slots, once the row before it in that slot is written. */
 typedef struct shared {
     const camera *cam;
     const povmesh_emitter *emitter;
@@ -139,7 +138,7 @@ typedef struct shared {
     int written_row;           /* rows before it are written: their slots are free */
     bool abort;
     row_out *slot;
-    int *state, *row_of;
+    int *ready_row;            /* of each slot: the row whose results it holds, -1 at first */
 } shared;
 
 static void *worker(void *arg)
@@ -155,13 +154,11 @@ static void *worker(void *arg)
             pthread_cond_wait(&sh->changed, &sh->lock);
         if (sh->abort)
             break;
-        sh->state[k] = SLOT_BUSY;
-        sh->row_of[k] = py;
         pthread_mutex_unlock(&sh->lock);
         b->n = 0;
         trace_row(sh->cam, sh->emitter, py, b, &sh->slot[k]);
         pthread_mutex_lock(&sh->lock);
-        sh->state[k] = SLOT_READY;
+        sh->ready_row[k] = py;
         pthread_cond_broadcast(&sh->changed);
     }
     if (!b)
@@ -180,7 +177,7 @@ static int write_rows(shared *sh, povmesh_emitter *e, progress *bar, raytable_st
     for (int py = sh->first_row; py < sh->end_row && !st; py++) {
         const int k = (py - sh->first_row) % sh->slots;
         pthread_mutex_lock(&sh->lock);
-        while (!(sh->state[k] == SLOT_READY && sh->row_of[k] == py) && !sh->abort)
+        while (sh->ready_row[k] != py && !sh->abort)
             pthread_cond_wait(&sh->changed, &sh->lock);
         const bool aborted = sh->abort;
         pthread_mutex_unlock(&sh->lock);
@@ -188,7 +185,6 @@ static int write_rows(shared *sh, povmesh_emitter *e, progress *bar, raytable_st
             return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
         st = append_row(e, &sh->slot[k], stats, err);
         pthread_mutex_lock(&sh->lock);
-        sh->state[k] = SLOT_FREE;
         sh->written_row = py + 1;
         pthread_cond_broadcast(&sh->changed);
         pthread_mutex_unlock(&sh->lock);
@@ -210,10 +206,11 @@ static int trace_rows(const camera *c, povmesh_emitter *e, progress *bar, raytab
     shared sh = {.cam = c, .emitter = e, .next_row = c->crop_y0, .end_row = c->crop_y1,
                  .first_row = c->crop_y0, .written_row = c->crop_y0, .slots = 2 * workers};
     sh.slot = calloc((size_t)sh.slots, sizeof *sh.slot);
-    sh.state = calloc((size_t)sh.slots, sizeof *sh.state);
-    sh.row_of = calloc((size_t)sh.slots, sizeof *sh.row_of);
+    sh.ready_row = malloc((size_t)sh.slots * sizeof *sh.ready_row);
     const long long rays = (long long)(c->crop_x1 - c->crop_x0) * c->samples.spp;
-    int st = sh.slot && sh.state && sh.row_of ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    int st = sh.slot && sh.ready_row ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < sh.slots && !st; k++)
+        sh.ready_row[k] = -1;
     for (int k = 0; k < sh.slots && !st; k++)
         if (row_reserve(&sh.slot[k], rays, povmesh_wants_csv(e)))
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
@@ -236,8 +233,7 @@ static int trace_rows(const camera *c, povmesh_emitter *e, progress *bar, raytab
     for (int k = 0; sh.slot && k < sh.slots; k++)
         row_free(&sh.slot[k]);
     free(sh.slot);
-    free(sh.state);
-    free(sh.row_of);
+    free(sh.ready_row);
     pthread_mutex_destroy(&sh.lock);
     pthread_cond_destroy(&sh.changed);
     return st;
