@@ -253,11 +253,11 @@ static bool trace_thick(const camera *c, ray *r)
     return v3_isfinite(r->o);
 }
 
-static void soa_from_rays(trace_soa *b, const ray *r, int n)
+static void soa_from_rays(trace_soa *b, const vec3 *origin, const vec3 *direction, int n)
 {
     for (int k = 0; k < n; k++) {
-        b->ox[k] = r[k].o.x; b->oy[k] = r[k].o.y; b->oz[k] = r[k].o.z;
-        b->dx[k] = r[k].d.x; b->dy[k] = r[k].d.y; b->dz[k] = r[k].d.z;
+        b->ox[k] = origin[k].x; b->oy[k] = origin[k].y; b->oz[k] = origin[k].z;
+        b->dx[k] = direction[k].x; b->dy[k] = direction[k].y; b->dz[k] = direction[k].z;
     }
 }
 
@@ -273,23 +273,28 @@ void camera_trace_batch(const camera *c, const vec3 *film_points, const double *
                         const double *v, int n, ray *out, double *weight, bool *passed)
 {
     trace_soa b;
+    vec3 direction[CAMERA_BATCH];
+    pupil_film_rays(&c->pupil, n, film_points, u, v, direction, weight);
     for (int k = 0; k < n; k++) {
-        out[k].o = film_points[k];
-        weight[k] = pupil_film_ray(&c->pupil, film_points[k], u[k], v[k], &out[k].d) * c->weight_scale;
-        b.status[k] = weight[k] > 0.0 && isfinite(weight[k]) && v3_isfinite(out[k].d)
+        weight[k] *= c->weight_scale;
+        b.status[k] = weight[k] > 0.0 && isfinite(weight[k]) && v3_isfinite(direction[k])
                           ? TRACE_PASSED : TRACE_MISSED;
     }
     if (c->trace == TRACE_KIND_THICK) {
-        for (int k = 0; k < n; k++)
+        for (int k = 0; k < n; k++) {
+            out[k].o = film_points[k];
+            out[k].d = direction[k];
             if (b.status[k] == TRACE_PASSED && !trace_thick(c, &out[k]))
                 b.status[k] = TRACE_MISSED;
+        }
     } else {
-        soa_from_rays(&b, out, n);
+        soa_from_rays(&b, film_points, direction, n);
         trace_soa_toward_scene(&c->lens, &b, n);
         rays_from_soa(out, &b, n);
     }
+    /* & rather than &&: whether a ray passed is unpredictable, a branch on it costly. */
     for (int k = 0; k < n; k++)
-        passed[k] = b.status[k] == TRACE_PASSED && v3_isfinite(out[k].o) && v3_isfinite(out[k].d);
+        passed[k] = (b.status[k] == TRACE_PASSED) & v3_isfinite(out[k].o) & v3_isfinite(out[k].d);
 }
 
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight)

@@ -10,9 +10,21 @@ void film_init(film *f, int width, int height, double diagonal_mm)
     f->height_mm = a * f->width_mm;
 }
 
-vec3 film_camera_from_raster(const film *f, double rx, double ry)
+/* Granlund and Montgomery ("Division by invariant integers using multiplication", 1994,
+   theorem 4.2): with 2^(l - 1) < d <= 2^l and m = ceil(2^(31 + l) / d), n / d is
+   (n m) >> (31 + l) for every 0 <= n < 2^31. m <= 2^32, so n m < 2^63 fits. */
+static void divisor_init(uint32_t d, uint64_t *multiplier, int *shift)
 {
-    return v3((0.5 - rx / f->width) * f->width_mm, (ry / f->height - 0.5) * f->height_mm, 0.0);
+    int l = 0;
+    while ((1ULL << l) < d)
+        l++;
+    *shift = 31 + l;
+    *multiplier = ((1ULL << *shift) + d - 1) / d;
+}
+
+static uint32_t divide_by_gx(const sample_pattern *p, uint32_t n)
+{
+    return (uint32_t)(((uint64_t)n * p->gx_multiplier) >> p->gx_shift);
 }
 
 void sample_pattern_init(sample_pattern *p, int spp, uint64_t seed)
@@ -25,6 +37,10 @@ void sample_pattern_init(sample_pattern *p, int spp, uint64_t seed)
     p->gx = spp / gx;
     p->gy = gx;
     p->seed = seed;
+    divisor_init((uint32_t)p->gx, &p->gx_multiplier, &p->gx_shift);
+    uint32_t w = (uint32_t)spp - 1;
+    w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
+    p->permute_mask = w;
 }
 
 /* splitmix64's finaliser: a bijective, well-mixed hash of 64 bits. */
@@ -35,14 +51,13 @@ static uint64_t mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
-static double unit_double(uint64_t h) { return (double)(h >> 11) * 0x1.0p-53; }
+/* h >> 11 < 2^53 converts exactly; through int64_t it takes one instruction. */
+static double unit_double(uint64_t h) { return (double)(int64_t)(h >> 11) * 0x1.0p-53; }
 
 /* Kensler's permute(): a bijection of [0, n) chosen by key, by cycle-walking a hash on the
-   next power of two. */
-static uint32_t permute(uint32_t i, uint32_t n, uint32_t key)
+   next power of two (w: that power less one). */
+static uint32_t permute(uint32_t i, uint32_t n, uint32_t w, uint32_t key)
 {
-    uint32_t w = n - 1;
-    w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
     do {
         i ^= key; i *= 0xe170893d; i ^= key >> 16; i ^= (i & w) >> 4; i ^= key >> 8;
         i *= 0x0929eb3f; i ^= key >> 23; i ^= (i & w) >> 1; i *= 1 | key >> 27;
@@ -52,15 +67,29 @@ static uint32_t permute(uint32_t i, uint32_t n, uint32_t key)
     return i;
 }
 
+sample_pixel sample_pattern_pixel(const sample_pattern *p, int px, int py)
+{
+    sample_pixel pixel;
+    pixel.hash = mix64(p->seed ^ mix64(((uint64_t)(uint32_t)py << 32) | (uint32_t)px));
+    return pixel;
+}
+
+film_sample sample_pattern_sample(const sample_pattern *p, sample_pixel pixel, int k)
+{
+    const uint64_t h1 = mix64(pixel.hash + 4 * (uint64_t)k + 1);
+    const uint64_t h2 = mix64(pixel.hash + 4 * (uint64_t)k + 2);
+    const uint32_t pk = permute((uint32_t)k, (uint32_t)p->spp, p->permute_mask, (uint32_t)pixel.hash);
+    const uint32_t ky = divide_by_gx(p, (uint32_t)k), pky = divide_by_gx(p, pk);
+    const uint32_t kx = (uint32_t)k - ky * (uint32_t)p->gx, pkx = pk - pky * (uint32_t)p->gx;
+    film_sample s;
+    s.offset_x = (kx + unit_double(h1)) / p->gx;
+    s.offset_y = (ky + unit_double(mix64(h1))) / p->gy;
+    s.pupil_u = (pkx + unit_double(h2)) / p->gx;
+    s.pupil_v = (pky + unit_double(mix64(h2))) / p->gy;
+    return s;
+}
+
 film_sample sample_pattern_get(const sample_pattern *p, int px, int py, int k)
 {
-    const uint64_t pixel = mix64(p->seed ^ mix64(((uint64_t)(uint32_t)py << 32) | (uint32_t)px));
-    const uint64_t h1 = mix64(pixel + 4 * (uint64_t)k + 1), h2 = mix64(pixel + 4 * (uint64_t)k + 2);
-    const uint32_t pk = permute((uint32_t)k, (uint32_t)p->spp, (uint32_t)pixel);
-    film_sample s;
-    s.offset_x = ((k % p->gx) + unit_double(h1)) / p->gx;
-    s.offset_y = ((k / p->gx) + unit_double(mix64(h1))) / p->gy;
-    s.pupil_u = ((pk % p->gx) + unit_double(h2)) / p->gx;
-    s.pupil_v = ((pk / p->gx) + unit_double(mix64(h2))) / p->gy;
-    return s;
+    return sample_pattern_sample(p, sample_pattern_pixel(p, px, py), k);
 }

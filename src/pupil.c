@@ -70,7 +70,9 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err)
     return L2P_OK;
 }
 
-void concentric_disk(double u, double v, double *x, double *y)
+/* The bodies of concentric_disk and pupil_direction, inlined into pupil_film_rays, which runs
+   for every film sample. */
+static inline void disk_point(double u, double v, double *x, double *y)
 {
     const double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
     if (a == 0.0 && b == 0.0) {
@@ -89,27 +91,72 @@ void concentric_disk(double u, double v, double *x, double *y)
     *y = r * sin(phi);
 }
 
-vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
+static inline vec3 direction_toward(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 {
     /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */
     const vec3 d = v3_sub(v3(x_mm, y_mm, pu->z_mm), film_point);
     return v3_normalize(pu->z_mm < 0.0 ? v3_scale(d, -1.0) : d);
 }
 
+/* The ring of film point (x, y): hypot(x, y) / ring_width_mm rounded down, at most
+   PUPIL_RINGS - 1 (also for NaN). hypot is slow. Where the squares neither overflow nor
+   underflow, sqrt(x^2 + y^2) and hypot are both within a few ulps of the exact radius, so
+   when the quotient widened by 1e-12 (relative, thousands of ulps) either side lies in one
+   ring, hypot's lies in it too; only nearer a ring's edge does hypot decide. */
+static inline int ring_index(const pupil *pu, double x, double y)
+{
+    if (!(pu->ring_width_mm > 0.0))
+        return 0;
+    const double r2_mm2 = x * x + y * y;
+    if (r2_mm2 > 0x1p-900 && r2_mm2 < 0x1p900) {
+        const double q = sqrt(r2_mm2) / pu->ring_width_mm;
+        const double low = q * (1.0 - 1e-12), high = q * (1.0 + 1e-12);
+        if (low >= PUPIL_RINGS - 1)
+            return PUPIL_RINGS - 1;
+        if (high < PUPIL_RINGS - 1 && (int)low == (int)high)
+            return (int)low;
+    }
+    const double q = hypot(x, y) / pu->ring_width_mm;
+    return q < PUPIL_RINGS - 1 ? (int)q : PUPIL_RINGS - 1;
+}
+
+void concentric_disk(double u, double v, double *x, double *y) { disk_point(u, v, x, y); }
+
+vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
+{
+    return direction_toward(pu, film_point, x_mm, y_mm);
+}
+
 double pupil_ring_radius_mm(const pupil *pu, vec3 film_point)
 {
-    const double r = hypot(film_point.x, film_point.y);
-    int ring = pu->ring_width_mm > 0.0 ? (int)fmin(r / pu->ring_width_mm, PUPIL_RINGS - 1) : 0;
-    return pu->ring_radius_mm[ring < 0 ? 0 : ring];
+    return pu->ring_radius_mm[ring_index(pu, film_point.x, film_point.y)];
+}
+
+/* In passes over the batch, each a short chain of arithmetic per sample, so that the sines,
+   square roots and divisions of different samples overlap. */
+void pupil_film_rays(const pupil *pu, int n, const vec3 *film_points, const double *u,
+                     const double *v, vec3 *directions, double *weights)
+{
+    for (int k = 0; k < n; k++) {            /* the points on the unit disk, kept in directions */
+        double x, y;
+        disk_point(u[k], v[k], &x, &y);
+        directions[k] = v3(x, y, 0.0);
+    }
+    for (int k = 0; k < n; k++)              /* the radii of the rings, kept in weights */
+        weights[k] = pu->ring_radius_mm[ring_index(pu, film_points[k].x, film_points[k].y)];
+    for (int k = 0; k < n; k++) {
+        const double radius = weights[k];
+        directions[k] = direction_toward(pu, film_points[k], directions[k].x * radius,
+                                         directions[k].y * radius);
+        const double cos_theta = directions[k].z;
+        const double area = M_PI * radius * radius;
+        weights[k] = area * (cos_theta * cos_theta) * (cos_theta * cos_theta) / (pu->z_mm * pu->z_mm);
+    }
 }
 
 double pupil_film_ray(const pupil *pu, vec3 film_point, double u, double v, vec3 *direction)
 {
-    double dx, dy;
-    concentric_disk(u, v, &dx, &dy);
-    const double radius = pupil_ring_radius_mm(pu, film_point);
-    *direction = pupil_direction(pu, film_point, dx * radius, dy * radius);
-    const double cos_theta = direction->z;
-    const double area = M_PI * radius * radius;
-    return area * (cos_theta * cos_theta) * (cos_theta * cos_theta) / (pu->z_mm * pu->z_mm);
+    double weight;
+    pupil_film_rays(pu, 1, &film_point, &u, &v, direction, &weight);
+    return weight;
 }

@@ -58,6 +58,11 @@ void pupil_cover(pupil *pu, const lens *l, double film_radius_mm);
    Returns the weight; 0 when the pupil lies in the film plane. */
 double pupil_film_ray(const pupil *pu, vec3 film_point, double u, double v, vec3 *direction);
 
+/* The same for n film samples at once, faster: directions[k] and weights[k] are what
+   pupil_film_ray gives for film_points[k], u[k] and v[k], bit for bit. */
+void pupil_film_rays(const pupil *pu, int n, const vec3 *film_points, const double *u,
+                     const double *v, vec3 *directions, double *weights);
+
 /* The unit direction from film point p toward point (x, y) of the pupil plane, and the radius
    of the disk sampled for p. */
 vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm);

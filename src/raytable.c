@@ -92,9 +92,10 @@ static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *
 {
     o->text_len = o->csv_len = 0;
     o->samples = o->passed = 0;
-    for (int px = c->crop_x0; px < c->crop_x1; px++)
+    for (int px = c->crop_x0; px < c->crop_x1; px++) {
+        const sample_pixel pixel = sample_pattern_pixel(&c->samples, px, py);
         for (int k = 0; k < c->samples.spp; k++) {
-            const film_sample s = sample_pattern_get(&c->samples, px, py, k);
+            const film_sample s = sample_pattern_sample(&c->samples, pixel, k);
             emitted_ray *r = &b->r[b->n];
             r->px = px;
             r->py = py;
@@ -107,6 +108,7 @@ static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *
             if (++b->n == CAMERA_BATCH)
                 flush_batch(c, e, b, o);
         }
+    }
     flush_batch(c, e, b, o);
 }
 

@@ -64,9 +64,10 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
         int b = 0;
         const double start = now();
         for (int py = 0; py < c.film.height; py++)
-            for (int px = 0; px < c.film.width; px++)
+            for (int px = 0; px < c.film.width; px++) {
+                const sample_pixel pixel = sample_pattern_pixel(&c.samples, px, py);
                 for (int k = 0; k < c.samples.spp; k++) {
-                    film_sample s = sample_pattern_get(&c.samples, px, py, k);
+                    film_sample s = sample_pattern_sample(&c.samples, pixel, k);
                     fp[b] = film_camera_from_raster(&c.film, px + s.offset_x, py + s.offset_y);
                     u[b] = s.pupil_u;
                     v[b] = s.pupil_v;
@@ -78,6 +79,7 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
                     n += b;
                     b = 0;
                 }
+            }
         rate[run] = (double)n / (now() - start);
         passed_fraction = (double)passed / (double)n;
     }
