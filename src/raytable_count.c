@@ -21,9 +21,10 @@ static long long count_row(const camera *c, int py)
     bool passed[CAMERA_BATCH];
     long long n = 0;
     int b = 0;
-    for (int px = c->crop_x0; px < c->crop_x1; px++)
+    for (int px = c->crop_x0; px < c->crop_x1; px++) {
+        const sample_pixel pixel = sample_pattern_pixel(&c->samples, px, py);
         for (int k = 0; k < c->samples.spp; k++) {
-            const film_sample s = sample_pattern_get(&c->samples, px, py, k);
+            const film_sample s = sample_pattern_sample(&c->samples, pixel, k);
             film[b] = film_camera_from_raster(&c->film, px + s.offset_x, py + s.offset_y);
             u[b] = s.pupil_u;
             v[b] = s.pupil_v;
@@ -35,6 +36,7 @@ static long long count_row(const camera *c, int py)
                 n += passed[j];
             b = 0;
         }
+    }
     return n;
 }
 
