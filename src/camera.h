@@ -10,6 +10,7 @@
 #include "pupil.h"
 #include "thicklens.h"
 #include "trace.h"
+#include "trace_batch.h"
 
 typedef enum trace_kind { TRACE_KIND_FULL, TRACE_KIND_THICK } trace_kind;
 typedef enum weighting { WEIGHTING_NORMALIZED, WEIGHTING_PHYSICAL } weighting;
@@ -61,7 +62,7 @@ void camera_free(camera *c);
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight);
 
 /* The same for n <= CAMERA_BATCH samples at once, interleaved for speed. */
-enum { CAMERA_BATCH = 64 };   /* = TRACE_SOA_MAX */
+enum { CAMERA_BATCH = TRACE_SOA_MAX };   /* one call of the batch tracer */
 void camera_trace_batch(const camera *c, const vec3 *film_points, const double *u,
                         const double *v, int n, ray *out, double *weight, bool *passed);
 

@@ -11,6 +11,10 @@
    the light such rays carry (cos^4 weighted, at the rim of the bundle) is negligible. */
 #define TRACE_GRAZING_COS 1e-4
 
+/* A ray more than this many radii from a surface's vertex plane is carried to that plane before
+   the intersection (Spencer and Murty; trace_kernel.h): the error stays within 16 ulp. */
+#define TRACE_TRANSFER_RADII 4
+
 typedef struct ray {
     vec3 o;  /* origin, camera space, mm */
     vec3 d;  /* unit direction */

@@ -22,18 +22,15 @@ static inline KVEC KNAME(madd)(KVEC a, KVEC b, KREAL s)
    Spencer and Murty (JOSA 52, 1962) first carry the ray to the vertex's tangent plane: from an
    origin n radii away B^2 and c C agree to about 1/n^2 and their difference loses log10(n^2)
    digits. Rays from the neighbouring surface lose none worth a division, so the transfer is
-   made only from more than TRANSFER_RADII radii away. Then they take the root that tends
+   made only from more than TRACE_TRANSFER_RADII radii away. Then they take the root that tends
    to the vertex as t = -C / (B + sgn(B) sqrt(B^2 - c C)), which loses no digits as c -> 0;
    the other root is -(B + sgn(B) sqrt(B^2 - c C)) / c. The unit normal is (c x, c y, 1 + c s);
    its z component is positive on the cap that holds the vertex, the only part the lens has. */
-/* Beyond this many radii from the vertex plane a ray is carried to it first (error <= 16 ulp). */
-#ifndef TRANSFER_RADII
-#define TRANSFER_RADII 4
-#endif
+/* TRACE_TRANSFER_RADII (trace.h): beyond it a ray is carried to the vertex plane first. */
 
 static inline int KNAME(needs_transfer)(KREAL c, KREAL pz, KREAL dz)
 {
-    return fabs(dz) > (KREAL)1e-6 && fabs(c * pz) > TRANSFER_RADII;
+    return fabs(dz) > (KREAL)1e-6 && fabs(c * pz) > TRACE_TRANSFER_RADII;
 }
 
 static inline __attribute__((always_inline)) trace_status KNAME(intersect)(const lens_surface *s, KRAY *r, KVEC *normal)

@@ -13,8 +13,8 @@
      pick(m, a, b)   a where m, else b;  vabs, vcopysign, neg
    and names the entry point with LANES_ENTRY. */
 
-/* The same threshold as trace_kernel.h. */
-#define TRANSFER_RADII 4
+_Static_assert(TRACE_SOA_MAX % LANES == 0 && LANES <= 32,
+               "lane masks are unsigned ints, and a batch is whole steps");
 
 INLINE vd dot(vd ax, vd ay, vd az, vd bx, vd by, vd bz)
 {
@@ -36,7 +36,8 @@ INLINE vm intersect(const lens_surface *s, const vd o[3], const vd d[3], vd h[3]
     const double cs = s->curvature_per_mm;
     const vd c = splat(cs), zero = splat(0);
     const vd pz0 = sub(o[2], splat(s->vertex_z_mm));
-    const vm transfer = mand(gt(vabs(d[2]), splat(1e-6)), gt(vabs(mul(c, pz0)), splat(TRANSFER_RADII)));
+    const vm transfer = mand(gt(vabs(d[2]), splat(1e-6)),
+                             gt(vabs(mul(c, pz0)), splat(TRACE_TRANSFER_RADII)));
     vd t0 = zero, px = o[0], py = o[1], pz = pz0;
     if (bits(transfer)) {
         t0 = pick(transfer, dvd(neg(pz0), d[2]), zero);
@@ -61,11 +62,13 @@ INLINE vm intersect(const lens_surface *s, const vd o[3], const vd d[3], vd h[3]
 }
 
 /* The lanes of `alive` that fail at this surface get their status (in the kernel's order of
-   tests); returns the lanes still alive. Failures are rare, so the loop mostly does not run. */
+   tests); returns the lanes still alive. Failures are rare: mostly there is no loop at all. */
 INLINE unsigned settle(long long *status, unsigned alive, unsigned hit, unsigned inside,
                        unsigned tir, unsigned grazing)
 {
     const unsigned failed = alive & ~(hit & inside & ~tir & ~grazing);
+    if (!failed)
+        return alive;
     for (int i = 0; i < LANES; i++)
         if (failed >> i & 1)
             status[i] = !(hit >> i & 1) ? TRACE_MISSED : !(inside >> i & 1) ? TRACE_CLIPPED

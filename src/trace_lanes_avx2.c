@@ -1,6 +1,7 @@
 /* The lane tracer with AVX2: sixteen rays a step as four registers of four. Chosen at run
    time (trace_batch.c); the rest of the program stays baseline x86-64. No FMA: a fused
-   multiply-add rounds once where the one-ray kernel rounds twice. */
+   multiply-add rounds once where the one-ray kernel rounds twice (and the Makefile builds
+   with -ffp-contract=off, so the compiler fuses none either). */
 #include "trace_lanes_isa.h"
 
 #if defined(__x86_64__)

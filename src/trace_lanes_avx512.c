@@ -102,7 +102,15 @@ INLINE vd vcopysign(vd x, vd y)
     return r;
 }
 
-INLINE vd neg(vd x) { return sub(splat(0), x); }
+/* C's -x: flips the sign bit, also of 0 (0 - x would give +0 for +0). */
+INLINE vd neg(vd x)
+{
+    const __m512i sign = _mm512_set1_epi64((long long)0x8000000000000000ull);
+    vd r;
+    UNROLL for (int i = 0; i < VECS; i++)
+        r.p[i] = _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(x.p[i]), sign));
+    return r;
+}
 
 #define LANES_ENTRY __attribute__((target("avx512f"))) void trace_lanes_avx512
 #include "trace_lanes.h"

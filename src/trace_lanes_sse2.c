@@ -2,7 +2,7 @@
    four chains of divisions and square roots interleave. */
 #include "trace_lanes_isa.h"
 
-#if defined(__x86_64__) || defined(__SSE2__)
+#if defined(__x86_64__)
 #include <float.h>
 #include <immintrin.h>
 #include <math.h>

@@ -25,6 +25,7 @@ BINARY(dvd, R(div))
 BINARY(vand, R(and))
 BINARY(vor, R(or))
 BINARY(vandnot, R(andnot))
+BINARY(vxor, R(xor))
 BINARY(vmax, R(max))
 BINARY(lt, CMP_LT)
 BINARY(le, CMP_LE)
@@ -88,6 +89,6 @@ INLINE vm mask_of(unsigned lanes)
 INLINE vm mand(vm a, vm b) { return vand(a, b); }
 INLINE vm mor(vm a, vm b) { return vor(a, b); }
 INLINE vd pick(vm m, vd a, vd b) { return vor(vand(m, a), vandnot(m, b)); }
-INLINE vd neg(vd x) { return sub(splat(0), x); }
+INLINE vd neg(vd x) { return vxor(x, splat(-0.0)); }   /* C's -x: flips the sign, also of 0 */
 INLINE vd vabs(vd x) { return vandnot(splat(-0.0), x); }
 INLINE vd vcopysign(vd x, vd y) { return vor(vandnot(splat(-0.0), x), vand(splat(-0.0), y)); }

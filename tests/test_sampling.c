@@ -209,8 +209,9 @@ Test(sampling, pupil_ring_matches_hypot_everywhere_else)
     }
 }
 
-/* A batch through pupil_film_rays against the rays one at a time, with the disk's centre, its
-   diagonals and both halves of the map among the samples. */
+/* A batch through pupil_film_rays against ref_film_ray, the formula as first written
+   (pupil_film_ray is now the batch of one, so it cannot serve as the reference), with the
+   disk's centre, its diagonals and both halves of the map among the samples. */
 Test(sampling, pupil_film_rays_match_one_at_a_time)
 {
     enum { N = 64 };
@@ -232,7 +233,7 @@ Test(sampling, pupil_film_rays_match_one_at_a_time)
         pupil_film_rays(&pu, N, film, u, v, d, w);
         for (int k = 0; k < N; k++) {
             vec3 d1;
-            const double w1 = pupil_film_ray(&pu, film[k], u[k], v[k], &d1);
+            const double w1 = ref_film_ray(&pu, film[k], u[k], v[k], &d1);
             cr_assert(same_double(w[k], w1) && same_double(d[k].x, d1.x) &&
                       same_double(d[k].y, d1.y) && same_double(d[k].z, d1.z),
                       "z %g, sample %d: the batch differs from the single ray", z_mm[zi], k);

@@ -17,7 +17,7 @@ out=${FUZZ_BUILD:-$root/build-fuzz}
 cc=${FUZZ_CC:-clang}
 seconds=${FUZZ_SECONDS:-20}
 san='-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer'
-cflags="-std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -g -O1 -fno-math-errno -I$root/src"
+cflags="-std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -g -O1 -fno-math-errno -ffp-contract=off -I$root/src"
 
 mkdir -p "$out/obj"
 # Every C source but main.c, instrumented for coverage (fuzzer-no-link), into an archive: the
