@@ -43,6 +43,11 @@ int image_write_rgb(const char *path, int width, int height, const float *pixels
    or has no such attribute. For tests and `info`-like reports. */
 int image_get_attribute(const char *path, const char *name, char *buf, size_t len);
 
+/* Loads the image library now rather than on the first image read or write, so that a command
+   that will need it fails before its long work when it cannot be loaded: L2P_FAILED, with the
+   paths tried, as the other functions would fail. */
+int image_io_ready(l2p_error *err);
+
 #ifdef __cplusplus
 }
 #endif

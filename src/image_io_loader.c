@@ -102,7 +102,11 @@ static void load_bridge(void)
 {
     const char *forced = getenv("LENS2POV_IMAGE_IO");
     if (forced && *forced) {
-        try_load(forced);
+        /* dlopen would search its library path for a bare name: say so rather than guess. */
+        if (!strchr(forced, '/'))
+            note_failure(forced, "LENS2POV_IMAGE_IO must be a path, with a '/'");
+        else
+            try_load(forced);
         return;
     }
     char dir[PATH_MAX], path[PATH_MAX + 64];
@@ -126,6 +130,8 @@ static int bridge_ready(l2p_error *err)
                     "cannot load the image library " IMAGE_IO_LIBRARY " (OpenImageIO): tried %s",
                     bridge.why);
 }
+
+int image_io_ready(l2p_error *err) { return bridge_ready(err); }
 
 int image_read_rgba(const char *path, int *width, int *height, float **pixels, l2p_error *err)
 {

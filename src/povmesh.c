@@ -308,10 +308,17 @@ static void choose_layout(povmesh_emitter *e, long long chunk_faces)
                            c->samples.spp;
     e->packed_width = most < MAX_PACKED_WIDTH ? (int)(most > 0 ? most : 1) : MAX_PACKED_WIDTH;
     e->chunk_faces = 0;
-    /* Whole packed rows, rounded up: a chunk size the caller computed as an equal share of the
-       faces must not leave a few hundred faces over for a chunk of their own. */
-    if (chunk_faces > 0)
-        e->chunk_faces = (chunk_faces + e->packed_width - 1) / e->packed_width * e->packed_width;
+    if (chunk_faces <= 0)
+        return;
+    /* Chunks are whole packed rows. The rows are made as wide as needed to hold the asked chunk
+       size in as few rows as possible and no wider, so a chunk holds at most rows - 1 faces
+       more than asked: the caller's equal shares of the faces stay equal, and their number
+       stays the caller's (rounding up to rows of 1024 would turn 16 shares of 6,250 faces into
+       14 chunks of 7,168). */
+    const long long want = chunk_faces < most ? chunk_faces : (most > 0 ? most : 1);
+    const long long rows = (want + MAX_PACKED_WIDTH - 1) / MAX_PACKED_WIDTH;
+    e->packed_width = (int)((want + rows - 1) / rows);
+    e->chunk_faces = rows * e->packed_width;
 }
 
 static void free_emitter(povmesh_emitter *e)

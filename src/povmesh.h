@@ -31,9 +31,9 @@ typedef struct povmesh_chunk_info {
 typedef struct povmesh_emitter povmesh_emitter;
 
 /* Opens the outputs under temporary names. chunk_faces 0: one chunk, written as PREFIX.inc and
-   PREFIX.ini; otherwise chunks of chunk_faces faces rounded up to whole packed rows (of up to
-   1024 faces; the last chunk holds the rest), PREFIX.c000.inc, PREFIX.c000.ini, ... csv_path
-   may be NULL. */
+   PREFIX.ini; otherwise chunks of chunk_faces faces, rounded up to whole packed rows of up to
+   1024 faces by fewer than one face a row (the last chunk holds the rest), PREFIX.c000.inc,
+   PREFIX.c000.ini, ... csv_path may be NULL. */
 int povmesh_open(povmesh_emitter **e, const camera *c, const char *prefix, const char *csv_path,
                  long long chunk_faces, l2p_error *err);
 

@@ -56,12 +56,12 @@ long long raytable_count_faces(const camera *c)
     atomic_init(&t.next_row, c->crop_y0);
     atomic_init(&t.passed, 0);
     const long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    pthread_t thread[16];
+    const int helpers = cores < 1 ? 0 : cores > 16 ? 15 : (int)cores - 1;
+    pthread_t thread[15];
     int started = 0;
-    while (started < (cores < 1 ? 1 : cores > 16 ? 16 : cores) &&
-           pthread_create(&thread[started], NULL, count_rows, &t) == 0)
+    while (started < helpers && pthread_create(&thread[started], NULL, count_rows, &t) == 0)
         started++;
-    count_rows(&t);   /* this thread works too, and alone when no thread starts */
+    count_rows(&t);   /* this thread is the last worker, and works alone if none starts */
     for (int i = 0; i < started; i++)
         pthread_join(thread[i], NULL);
     return atomic_load(&t.passed);

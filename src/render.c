@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include "camera.h"
 #include "develop.h"
+#include "image_io.h"
 #include "outfile.h"
 #include "povray.h"
 #include "raytable.h"
@@ -138,7 +139,7 @@ int render_command(const cli *c, l2p_error *err)
 {
     int st = check_inputs(c, err);
     camera cam;
-    if (st)
+    if (st || (st = image_io_ready(err)))   /* before the long work that needs it at the end */
         return st;
     lens l;
     if ((st = lens_read(c->positional[1], &l, err)))

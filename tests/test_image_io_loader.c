@@ -2,6 +2,7 @@
    process: these tests point LENS2POV_IMAGE_IO at a missing file for lens2pov child processes,
    so that the loader runs afresh there and the test runner's own image reads are unaffected. */
 #include <criterion/criterion.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -55,4 +56,43 @@ Test(image_io_loader, info_runs_without_the_library)
     const int st = run_lens2pov(NULL, &errtext, "info", DGAUSS, NULL);
     cr_assert_eq(st, 0, "exit %d: %s", st, errtext);
     free(errtext);
+}
+
+/* render needs the library only to develop, at the very end: it must fail before the trace
+   (which would write the --rays CSV) and POV-Ray (which would report the scene's error). */
+Test(image_io_loader, render_fails_before_tracing)
+{
+    const char *dir = test_tmpdir();
+    const char *scene = tmp_path(dir, "s.pov"), *picture = tmp_path(dir, "s.png");
+    const char *csv = tmp_path(dir, "rays.csv");
+    write_text(scene, "#version 3.7;\nbackground { rgb 1 \n");
+    char *errtext = NULL;
+    const int st = run_lens2pov(NULL, &errtext, "render", scene, DGAUSS, "--width", "8",
+                                "--height", "6", "--spp", "1", "--rays", csv, "-o", picture, NULL);
+    cr_assert_eq(st, 1, "exit %d: %s", st, errtext);
+    cr_assert(strstr(errtext, "cannot load the image library"), "%s", errtext);
+    cr_assert(!strstr(errtext, "s.pov"), "POV-Ray did not run: %s", errtext);
+    struct stat s;
+    cr_assert_neq(stat(csv, &s), 0, "no trace ran");
+    cr_assert_neq(stat(picture, &s), 0, "no picture written");
+    free(errtext);
+}
+
+/* The point of the library: the executable itself does not link OpenImageIO (ldd lists what
+   the dynamic loader would map at start-up). */
+Test(image_io_loader, executable_does_not_link_openimageio)
+{
+    const char *bin = getenv("LENS2POV");
+    char command[4096];
+    snprintf(command, sizeof command, "ldd '%s' 2>&1", bin && *bin ? bin : "build/lens2pov");
+    FILE *p = popen(command, "r");
+    cr_assert_not_null(p);
+    char line[1024];
+    int libraries = 0;
+    while (fgets(line, sizeof line, p)) {
+        cr_assert(!strstr(line, "OpenImageIO"), "linked at start-up: %s", line);
+        libraries++;
+    }
+    cr_assert_eq(pclose(p), 0, "ldd failed");
+    cr_assert(libraries >= 2, "ldd listed %d libraries", libraries);
 }
