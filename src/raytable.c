@@ -1,7 +1,9 @@
 #include "raytable.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 #include <unistd.h>
 #include "progress.h"
@@ -68,10 +70,17 @@ typedef struct batch {
     bool passed[CAMERA_BATCH];
 } batch;
 
+/* Traces the batch and formats its passed rays into o; with no emitter, only counts them. */
 static void flush_batch(const camera *c, const povmesh_emitter *e, batch *b, row_out *o)
 {
     camera_trace_batch(c, b->film, b->u, b->v, b->n, b->out, b->weight, b->passed);
     o->samples += b->n;
+    if (!e) {
+        for (int k = 0; k < b->n; k++)
+            o->passed += b->passed[k];
+        b->n = 0;
+        return;
+    }
     const bool csv = povmesh_wants_csv(e);
     for (int k = 0; k < b->n; k++) {
         if (!b->passed[k])
@@ -260,4 +269,46 @@ int raytable_write(const camera *c, const char *prefix, const char *csv_path,
     if (stats)
         *stats = local;
     return st ? st : close_st;
+}
+
+/* How many faces the table will have: every sample of the crop traced, none formatted. The
+   renderer cuts the table into chunks of equal face counts from it, so that the POV-Ray
+   processes parse equal shares (cutting by samples leaves the vignetted rows' chunks short). */
+typedef struct counter {
+    const camera *cam;
+    atomic_int next_row;
+    atomic_llong passed;
+} counter;
+
+static void *count_rows(void *arg)
+{
+    counter *t = arg;
+    batch *b = malloc(sizeof *b);
+    row_out o;
+    memset(&o, 0, sizeof o);
+    long long passed = 0;
+    for (int py; b && (py = atomic_fetch_add(&t->next_row, 1)) < t->cam->crop_y1;) {
+        b->n = 0;
+        trace_row(t->cam, NULL, py, b, &o);
+        passed += o.passed;
+    }
+    atomic_fetch_add(&t->passed, passed);
+    free(b);   /* without it this worker took no row: the others take them */
+    return NULL;
+}
+
+long long raytable_count_faces(const camera *c)
+{
+    counter t = {.cam = c};
+    atomic_init(&t.next_row, c->crop_y0);
+    atomic_init(&t.passed, 0);
+    const int helpers = number_of_workers() - 1;
+    pthread_t thread[16];
+    int started = 0;
+    while (started < helpers && pthread_create(&thread[started], NULL, count_rows, &t) == 0)
+        started++;
+    count_rows(&t);   /* this thread is the last worker, and works alone if none starts */
+    for (int i = 0; i < started; i++)
+        pthread_join(thread[i], NULL);
+    return atomic_load(&t.next_row) >= c->crop_y1 ? atomic_load(&t.passed) : -1;
 }

@@ -20,7 +20,7 @@ typedef struct raytable_stats {
 long long raytable_faces_for_memory(double memory_mb);
 
 /* The faces raytable_write will write for c: the samples of the crop the lens passes. Traces
-   them all on every core (about a fifth of the cost of writing them). */
+   them all on every core (about a fifth of the cost of writing them); -1 out of memory. */
 long long raytable_count_faces(const camera *c);
 
 /* Traces crop pixels x spp samples and writes PREFIX.inc/.ini/.map (and csv_path when not

@@ -44,7 +44,10 @@ static int number_of_cores(void)
 static long long chunk_faces_for(const camera *cam, const cli *c, int jobs)
 {
     const long long budget = raytable_faces_for_memory(c->memory_mb);
-    const long long faces = raytable_count_faces(cam);
+    long long faces = raytable_count_faces(cam);
+    if (faces < 0)   /* out of memory to count: every sample, an upper bound */
+        faces = (long long)(cam->crop_x1 - cam->crop_x0) * (cam->crop_y1 - cam->crop_y0) *
+                cam->samples.spp;
     const long long needed = (faces + budget - 1) / budget;
     const long long chunks = needed < 1 ? jobs : (needed + jobs - 1) / jobs * jobs;
     const long long per_chunk = (faces + chunks - 1) / chunks;
