@@ -555,9 +555,9 @@ Test(render, crop_is_a_region_of_the_whole_picture)
     remove_dir(dir);
 }
 
-/* A memory budget of 0.05 MB gives chunks of one packed row each (1024 faces, lens2pov's
-   smallest chunk): 32x24 pixels of 6 samples make 5 POV-Ray runs, two at a time. They must
-   give exactly the picture of one run with the default budget: same rays, same sums. */
+/* A memory budget of 0.05 MB gives chunks of about 200 faces: 32x24 pixels of 6 samples make
+   some two dozen POV-Ray runs, two at a time. They must give exactly the picture of one run
+   with the default budget: same rays, same sums. */
 Test(render, chunks_and_jobs_do_not_change_the_picture)
 {
     NEW_DIR(dir);

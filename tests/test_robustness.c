@@ -328,33 +328,55 @@ Test(robustness, lens_paths_that_are_not_files)
     remove_tree(dir);
 }
 
+/* A complete small trace into DIR/p with its CSV, and the bytes of its four files, for the
+   tests that check a later run leaves them alone. */
+typedef struct previous_run {
+    char *text[4];
+    size_t length[4];
+} previous_run;
+
+static const char *const RUN_FILES[] = {"p.inc", "p.ini", "p.map", "p.csv"};
+
+static previous_run make_previous_run(const char *dir)
+{
+    char prefix[512], csv[512];
+    snprintf(prefix, sizeof prefix, "%s/p", dir);
+    snprintf(csv, sizeof csv, "%s/p.csv", dir);
+    cr_assert_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "8", "--height", "6",
+                              "--rays", csv, "-o", prefix, "--quiet", NULL), 0);
+    previous_run r;
+    for (int i = 0; i < 4; i++)
+        cr_assert_not_null(r.text[i] = read_text(tmp_path(dir, RUN_FILES[i]), &r.length[i]));
+    return r;
+}
+
+/* Each of the four files still holds the previous run's bytes; frees them. */
+static void expect_previous_run(const char *dir, previous_run *r, const char *after_what)
+{
+    for (int i = 0; i < 4; i++) {
+        size_t n;
+        char *now = read_text(tmp_path(dir, RUN_FILES[i]), &n);
+        cr_expect(now && n == r->length[i] && memcmp(now, r->text[i], n) == 0,
+                  "after %s: %s is not the previous run's any more", after_what, RUN_FILES[i]);
+        free(now);
+        free(r->text[i]);
+    }
+}
+
 /* A failed run (a bad option after good ones, a bad lens) leaves the outputs of the previous
    run untouched. */
 Test(robustness, a_failed_run_leaves_the_previous_outputs_alone)
 {
     const char *dir = test_tmpdir();
     const char *prefix = tmp_path(dir, "p"), *csv = tmp_path(dir, "p.csv");
-    cr_assert_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "8", "--height", "6",
-                              "--rays", csv, "-o", prefix, "--quiet", NULL), 0);
-    const char *names[] = {"p.inc", "p.ini", "p.map", "p.csv"};
-    char *before[4];
-    size_t len[4];
-    for (int i = 0; i < 4; i++)
-        cr_assert_not_null(before[i] = read_text(tmp_path(dir, names[i]), &len[i]));
+    previous_run before = make_previous_run(dir);
     const char *bad = tmp_path(dir, "bad.dat");
     write_text(bad, "50 5 1.5 20\n0 5 0 10\n-50 0 1\n");
     cr_expect_eq(run_lens2pov(NULL, NULL, "trace", bad, "--rays", csv, "-o", prefix, "--quiet",
                               NULL), 2);
     cr_expect_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "16", "--rays", csv,
                               "--aperture-diameter", "99", "-o", prefix, "--quiet", NULL), 2);
-    for (int i = 0; i < 4; i++) {
-        size_t n;
-        char *after = read_text(tmp_path(dir, names[i]), &n);
-        cr_expect(after && n == len[i] && memcmp(after, before[i], n) == 0, "%s changed",
-                  names[i]);
-        free(after);
-        free(before[i]);
-    }
+    expect_previous_run(dir, &before, "failed runs");
     const char *const allowed[] = {"p.inc", "p.ini", "p.map", "p.csv", "bad.dat", NULL};
     const char *first;
     cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "left %s", first);
@@ -432,13 +454,7 @@ static void kill_trace_while_writing(int sig)
     char prefix[512], csv[512];
     snprintf(prefix, sizeof prefix, "%s/p", dir);
     snprintf(csv, sizeof csv, "%s/p.csv", dir);
-    cr_assert_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "8", "--height", "6",
-                              "--rays", csv, "-o", prefix, "--quiet", NULL), 0);
-    const char *names[] = {"p.inc", "p.ini", "p.map", "p.csv"};
-    char *before[4];
-    size_t len[4];
-    for (int i = 0; i < 4; i++)
-        cr_assert_not_null(before[i] = read_text(tmp_path(dir, names[i]), &len[i]));
+    previous_run before = make_previous_run(dir);
 
     char *argv[] = {"trace", DGAUSS, "--width", "2000", "--height", "2000", "--spp", "4",
                     "--rays", csv, "-o", prefix, "--quiet", NULL};
@@ -453,14 +469,9 @@ static void kill_trace_while_writing(int sig)
     cr_expect(WIFSIGNALED(status) && WTERMSIG(status) == sig,
               "signal %d: the run ended with status %#x", sig, status);
 
-    for (int i = 0; i < 4; i++) {
-        size_t n;
-        char *after = read_text(tmp_path(dir, names[i]), &n);
-        cr_expect(after && n == len[i] && memcmp(after, before[i], n) == 0,
-                  "signal %d: %s is not the previous run's any more", sig, names[i]);
-        free(after);
-        free(before[i]);
-    }
+    char killed[32];
+    snprintf(killed, sizeof killed, "signal %d", sig);
+    expect_previous_run(dir, &before, killed);
     const char *const allowed[] = {"p.inc", "p.ini", "p.map", "p.csv", NULL};
     const char *first;
     const int stray = unexpected_files(dir, allowed, &first);
