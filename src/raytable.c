@@ -11,7 +11,7 @@
 long long raytable_faces_for_memory(double memory_mb)
 {
     const double mb = memory_mb > 0 ? memory_mb : RAYTABLE_DEFAULT_MEMORY_MB;
-    const long long faces = (long long)(mb * 1048576.0 / 265.0);
+    const long long faces = (long long)(mb * 1048576.0 / RAYTABLE_POVRAY_BYTES_PER_FACE);
     return faces > 0 ? faces : 1;
 }
 

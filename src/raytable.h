@@ -12,8 +12,10 @@ typedef struct raytable_stats {
     double seconds;
 } raytable_stats;
 
-/* POV-Ray needs about 265 bytes of memory per mesh_camera face (measured: see
-   ../shared/docs/povray-mesh-camera.md); the default budget is 1 GB a process. */
+/* POV-Ray 3.7.0.10 needs about 210 bytes of memory per mesh_camera face of a mesh with
+   "hierarchy off", its output image included (measured: 744k faces, peak RSS 164 MB against
+   15 MB for an empty scene); the default budget is 1 GB a process. */
+#define RAYTABLE_POVRAY_BYTES_PER_FACE 215.0
 #define RAYTABLE_DEFAULT_MEMORY_MB 1024.0
 
 /* Faces per chunk for a POV-Ray memory budget in MB (<= 0: the default). */

@@ -959,8 +959,8 @@ Test(stability, sweep_to_the_critical_angle)
 /* ---------------------------------------------------------------- a table too large */
 
 /* A ray table too large for one POV-Ray process: `render --memory-mb` caps each process's
-   share, and the table is split into chunks rendered one process each. A tiny budget (0.2 MB,
-   about 790 faces at 265 bytes a face) splits the ~9,400 faces of 64 x 48 x 4 samples into a
+   share, and the table is split into chunks rendered one process each. A tiny budget (0.15 MB,
+   about 730 faces at 215 bytes a face) splits the ~9,400 faces of 64 x 48 x 4 samples into a
    dozen chunks: the developed image must equal the one-chunk render bit for bit (both are
    half-float EXR of the same samples and weights). */
 static const char TINY_SCENE[] =
@@ -1049,12 +1049,12 @@ Test(stability, ray_table_too_large_for_one_povray_process)
     cr_assert_eq(st, 0, "one chunk: %s", errtext);
     free(errtext);
     st = run_lens2pov(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "64",
-                      "--height", "48", "--spp", "4", "--look-at", "0,0,3", "--memory-mb", "0.2",
+                      "--height", "48", "--spp", "4", "--look-at", "0,0,3", "--memory-mb", "0.15",
                       "--keep-temp", keep, "-o", many, "--quiet", NULL);
     cr_assert_eq(st, 0, "many chunks: %s", errtext);
     free(errtext);
     const int chunks = count_files_ending(keep, ".inc");
-    cr_assert_geq(chunks, 10, "a 0.2 MB budget splits ~9400 faces into chunks: %d", chunks);
+    cr_assert_geq(chunks, 10, "a 0.15 MB budget splits ~9400 faces into chunks: %d", chunks);
     int w1, h1, w2, h2;
     float *p1, *p2;
     l2p_error err;
@@ -1077,7 +1077,7 @@ Test(stability, ray_table_too_large_for_one_povray_process)
         FILE *f = fopen(file, "a");
         if (f) {
             fprintf(f, "big-table\tray table too large for one POV-Ray process (render "
-                       "--memory-mb 0.2)\trendered\t%d POV-Ray processes; the image equals "
+                       "--memory-mb 0.15)\trendered\t%d POV-Ray processes; the image equals "
                        "the 1-process render (%d values differ)\n", chunks, differ);
             fclose(f);
         }
