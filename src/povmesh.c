@@ -5,6 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "outfile.h"
+#include "povface.h"
 #include "samplemap.h"
 
 enum { BUFFER_BYTES = 1 << 20, MAX_PACKED_WIDTH = 1024, COUNT_FIELD = 20 };
@@ -21,8 +22,19 @@ typedef struct chunk {
     text_out inc;
     outfile ini;
     long count_offset;      /* where the vertex count goes, filled in at the end */
-    long long faces;
+    long long faces, vertices;
+    uint8_t *codes;         /* each face's vertex pattern (face_code), four faces a byte */
+    size_t codes_cap;
 } chunk;
+
+/* Where a face's vertices are, relative to the vertices written before it (n of them): the
+   face_indices are replayed from these at the end of the chunk. */
+enum face_code {
+    FACE_OWN = 0,           /* <n, n+1, n+2>, three vertices of its own */
+    FACE_OWN_SWAPPED = 1,   /* <n+1, n, n+2> */
+    FACE_SHARED = 2,        /* <n-3, n-2, n>, the edge of the face before and one of its own */
+    FACE_SHARED_SWAPPED = 3 /* <n-2, n-3, n> */
+};
 
 struct povmesh_emitter {
     const camera *cam;
@@ -35,6 +47,8 @@ struct povmesh_emitter {
     text_out csv;
     bool has_csv;
     long long faces;
+    char edge_text[POVMESH_RAY_TEXT_MAX];   /* the last shared edge's two vertex lines */
+    size_t edge_len;
     vec3 anchor_camera_mm;     /* the front vertex: vertices are written relative to it */
     double triangle_size;      /* scene units */
     int decimals;
@@ -103,19 +117,6 @@ static int reserve(text_out *t, size_t n, l2p_error *err)
     return t->len + n > BUFFER_BYTES ? flush_text(t, err) : L2P_OK;
 }
 
-void povmesh_triangle(vec3 o, vec3 d, double size, vec3 v[3])
-{
-    /* a, b span the plane normal to d with a x b = d; vertices at 0, 240 and 120 degrees give
-       (P3 - P1) x (P2 - P1) = +k d, the winding POV-Ray turns into direction d. */
-    const vec3 helper = fabs(d.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
-    const vec3 a = v3_normalize(v3_cross(d, helper));
-    const vec3 b = v3_cross(d, a);
-    const double c = -0.5 * size, s = 0.8660254037844386 * size;
-    v[0] = v3_madd(o, a, size);
-    v[1] = v3_add(o, v3_add(v3_scale(a, c), v3_scale(b, -s)));
-    v[2] = v3_add(o, v3_add(v3_scale(a, c), v3_scale(b, s)));
-}
-
 static char *chunk_path(const povmesh_emitter *e, int index, const char *ext)
 {
     size_t n = strlen(e->prefix) + 32;
@@ -180,44 +181,85 @@ static void put_vertex(text_out *t, const povmesh_emitter *e, vec3 v)
     put_text(t, ">,\n", 3);
 }
 
-/* Vertices of one ray, relative to the anchor, in scene units. */
-static void put_ray(text_out *t, const povmesh_emitter *e, const ray *r)
+/* A ray in the mesh's frame: scene units, world axes, relative to the anchor. */
+static ray mesh_ray(const povmesh_emitter *e, const ray *r)
 {
     const camera *c = e->cam;
     const vec3 rel = v3_sub(r->o, e->anchor_camera_mm);
     const vec3 o = v3_scale(v3_add(v3_add(v3_scale(c->right, rel.x), v3_scale(c->up, rel.y)),
                                    v3_scale(c->forward, rel.z)), 1.0 / c->unit_mm);
-    vec3 v[3];
-    povmesh_triangle(o, camera_world_from_camera_dir(c, r->d), e->triangle_size, v);
+    return (ray){o, camera_world_from_camera_dir(c, r->d)};
+}
+
+/* Formats face i alone, or faces i and i + 1 on a shared edge; returns the faces done. */
+static int put_faces_of(const povmesh_emitter *e, const emitted_ray *r, int i, int n,
+                        text_out *t, size_t *len, unsigned char *kind)
+{
+    const ray a = mesh_ray(e, &r[i].out);
+    vec3 v[4];
+    bool swap[2];
+    if (i + 1 < n) {
+        const ray b = mesh_ray(e, &r[i + 1].out);
+        if (povface_pair(a.o, a.d, b.o, b.d, e->triangle_size, v, swap)) {
+            const size_t start = t->len;
+            for (int k = 0; k < 3; k++)
+                put_vertex(t, e, v[k]);
+            len[i] = t->len - start;
+            kind[i] = (unsigned char)(POVMESH_GIVES_EDGE | (swap[0] ? POVMESH_SWAPPED : 0));
+            put_vertex(t, e, v[3]);
+            len[i + 1] = t->len - start - len[i];
+            kind[i + 1] = (unsigned char)(POVMESH_SHARES_EDGE | (swap[1] ? POVMESH_SWAPPED : 0));
+            return 2;
+        }
+    }
+    const size_t start = t->len;
+    povface_single(a.o, a.d, e->triangle_size, v);
     for (int k = 0; k < 3; k++)
         put_vertex(t, e, v[k]);
+    len[i] = t->len - start;
+    kind[i] = 0;
+    return 1;
 }
 
-static void put_faces(text_out *t, long long first, long long count)
+static void put_index_triple(text_out *t, uint64_t a, uint64_t b, uint64_t c)
 {
-    for (long long k = 0; k < count; k++) {
-        const uint64_t a = 3 * (uint64_t)(first + k);
-        t->buf[t->len++] = '<';
-        put_uint(t, a);
-        t->buf[t->len++] = ',';
-        put_uint(t, a + 1);
-        t->buf[t->len++] = ',';
-        put_uint(t, a + 2);
-        put_text(t, ">,\n", 3);
-    }
+    t->buf[t->len++] = '<';
+    put_uint(t, a);
+    t->buf[t->len++] = ',';
+    put_uint(t, b);
+    t->buf[t->len++] = ',';
+    put_uint(t, c);
+    put_text(t, ">,\n", 3);
 }
 
-static int write_faces(text_out *t, long long count, l2p_error *err)
+static int face_code(const chunk *ch, long long face)
+{
+    return ch->codes[face >> 2] >> (2 * (face & 3)) & 3;
+}
+
+/* The face_indices, replayed from the faces' codes. */
+static int write_faces(text_out *t, const chunk *ch, long long count, l2p_error *err)
 {
     t->len += (size_t)snprintf(t->buf + t->len, 64, "  }\n  face_indices { %lld,\n", count);
+    uint64_t n = 0;   /* vertices before the face */
     /* A face takes at most 3 * 20 + 6 bytes; batches of 4096 fit in 4096 * 72. */
     for (long long done = 0; done < count;) {
-        const long long n = count - done < 4096 ? count - done : 4096;
+        const long long end = count - done < 4096 ? count : done + 4096;
         int st = reserve(t, 4096 * 72, err);
         if (st)
             return st;
-        put_faces(t, done, n);
-        done += n;
+        for (; done < end; done++) {
+            const int code = ch->codes ? face_code(ch, done) : FACE_OWN;
+            if (code == FACE_OWN || code == FACE_OWN_SWAPPED) {
+                const uint64_t first = code == FACE_OWN ? n : n + 1;
+                put_index_triple(t, first, first == n ? n + 1 : n, n + 2);
+                n += 3;
+            } else {
+                const uint64_t first = code == FACE_SHARED ? n - 3 : n - 2;
+                put_index_triple(t, first, first == n - 3 ? n - 2 : n - 3, n);
+                n += 1;
+            }
+        }
     }
     return L2P_OK;
 }
@@ -269,22 +311,23 @@ static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)
 {
     chunk *ch = &e->chunks[index];
     text_out *t = &ch->inc;
-    long long faces = ch->faces;
+    long long faces = ch->faces, vertices = ch->vertices;
     int st = reserve(t, 1024, err);
     if (st)
         return st;
     if (faces == 0) {          /* nothing passed the lens: one zero-area face, a ray to nowhere */
         put_str(t, "<0,0,0>,<0,0,0>,<0,0,0>,\n");
         faces = 1;
+        vertices = 3;
     }
-    st = write_faces(t, faces, err);
+    st = write_faces(t, ch, faces, err);
     if (st)
         return st;
     put_camera(t, e);
     if ((st = flush_text(t, err)) != 0)
         return st;
     if (fseek(t->file.fp, ch->count_offset, SEEK_SET) != 0 ||
-        fprintf(t->file.fp, "%*lld", COUNT_FIELD, 3 * faces) != COUNT_FIELD)
+        fprintf(t->file.fp, "%*lld", COUNT_FIELD, vertices) != COUNT_FIELD)
         return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "write failed");
     if ((st = outfile_finish(&t->file, err)) != 0)
         return st;
@@ -328,6 +371,7 @@ static void free_emitter(povmesh_emitter *e)
     for (int i = 0; i < e->chunk_count; i++) {
         discard_text(&e->chunks[i].inc);
         outfile_discard(&e->chunks[i].ini);
+        free(e->chunks[i].codes);
     }
     free(e->chunks);
     outfile_discard(&e->map);
@@ -386,23 +430,79 @@ int povmesh_open(povmesh_emitter **out, const camera *c, const char *prefix, con
 
 bool povmesh_wants_csv(const povmesh_emitter *e) { return e->has_csv; }
 
-size_t povmesh_format_ray(const povmesh_emitter *e, const emitted_ray *r, char *text,
-                          samplemap_record *rec, char *csv, size_t *csv_len)
+static size_t put_csv(char *csv, const emitted_ray *r)
+{
+    return (size_t)snprintf(csv, POVMESH_CSV_MAX,
+        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+        r->px + r->offset_x, r->py + r->offset_y, r->film_point.x, r->film_point.y,
+        r->out.o.x, r->out.o.y, r->out.o.z, r->out.d.x, r->out.d.y, r->out.d.z, r->weight);
+}
+
+size_t povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n, char *text,
+                           size_t *len, unsigned char *kind, samplemap_record *rec, char *csv,
+                           size_t *csv_len)
 {
     text_out t = {.buf = text, .len = 0};
-    put_ray(&t, e, &r->out);
-    *rec = (samplemap_record){(uint32_t)r->py * (uint32_t)e->cam->film.width + (uint32_t)r->px,
-                              (float)r->offset_x, (float)r->offset_y, (float)r->weight};
-    if (csv)
-        *csv_len = (size_t)snprintf(csv, POVMESH_CSV_MAX,
-            "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-            r->px + r->offset_x, r->py + r->offset_y, r->film_point.x, r->film_point.y,
-            r->out.o.x, r->out.o.y, r->out.o.z, r->out.d.x, r->out.d.y, r->out.d.z, r->weight);
+    for (int i = 0; i < n;)
+        i += put_faces_of(e, r, i, n, &t, len, kind);
+    for (int i = 0; i < n; i++) {
+        rec[i] = (samplemap_record){(uint32_t)r[i].py * (uint32_t)e->cam->film.width +
+                                        (uint32_t)r[i].px,
+                                    (float)r[i].offset_x, (float)r[i].offset_y,
+                                    (float)r[i].weight};
+        if (csv) {
+            csv_len[i] = put_csv(csv, &r[i]);
+            csv += csv_len[i];
+        }
+    }
     return t.len;
 }
 
-int povmesh_append(povmesh_emitter *e, const char *text, size_t len, const samplemap_record *rec,
-                   const char *csv, size_t csv_len, l2p_error *err)
+/* Records face's code, four to a byte. */
+static int push_code(chunk *ch, int code)
+{
+    const size_t byte = (size_t)(ch->faces >> 2);
+    if (byte >= ch->codes_cap) {
+        const size_t cap = ch->codes_cap ? 2 * ch->codes_cap : 4096;
+        uint8_t *grown = realloc(ch->codes, cap);
+        if (!grown)
+            return -1;
+        memset(grown + ch->codes_cap, 0, cap - ch->codes_cap);
+        ch->codes = grown;
+        ch->codes_cap = cap;
+    }
+    ch->codes[byte] |= (uint8_t)(code << (2 * (ch->faces & 3)));
+    return 0;
+}
+
+/* The vertex text of one face, and its code. A face that shares the edge of a face left in
+   the previous chunk gets the edge's vertices again. */
+static int put_face(povmesh_emitter *e, chunk *ch, const char *text, size_t len, unsigned kind,
+                    l2p_error *err)
+{
+    const bool shares = kind & POVMESH_SHARES_EDGE, alone = shares && ch->faces == 0;
+    int st = reserve(&ch->inc, len + (alone ? e->edge_len : 0), err);
+    if (st)
+        return st;
+    if (kind & POVMESH_GIVES_EDGE) {   /* its first two lines are the edge */
+        const char *end = memchr(text, '\n', len);
+        end = end ? memchr(end + 1, '\n', len - (size_t)(end + 1 - text)) : NULL;
+        e->edge_len = end ? (size_t)(end + 1 - text) : 0;
+        memcpy(e->edge_text, text, e->edge_len);
+    }
+    if (alone)
+        put_text(&ch->inc, e->edge_text, e->edge_len);
+    put_text(&ch->inc, text, len);
+    const int swapped = kind & POVMESH_SWAPPED ? 1 : 0;
+    const int code = shares && !alone ? FACE_SHARED + swapped : FACE_OWN + swapped;
+    if (push_code(ch, code))
+        return l2p_fail(err, L2P_FAILED, ch->inc.file.final_path, 0, "out of memory");
+    ch->vertices += code >= FACE_SHARED ? 1 : 3;
+    return L2P_OK;
+}
+
+int povmesh_append(povmesh_emitter *e, const char *text, size_t len, unsigned kind,
+                   const samplemap_record *rec, const char *csv, size_t csv_len, l2p_error *err)
 {
     int st;
     chunk *ch = &e->chunks[e->chunk_count - 1];
@@ -411,9 +511,8 @@ int povmesh_append(povmesh_emitter *e, const char *text, size_t len, const sampl
             return st;
         ch = &e->chunks[e->chunk_count - 1];
     }
-    if ((st = reserve(&ch->inc, len, err)) != 0)
+    if ((st = put_face(e, ch, text, len, kind, err)) != 0)
         return st;
-    put_text(&ch->inc, text, len);
     ch->faces++;
     e->faces++;
     if (samplemap_append(e->map.fp, rec, 1) != 0)
@@ -424,15 +523,6 @@ int povmesh_append(povmesh_emitter *e, const char *text, size_t len, const sampl
         return st;
     put_text(&e->csv, csv, csv_len);
     return L2P_OK;
-}
-
-int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err)
-{
-    char text[POVMESH_RAY_TEXT_MAX], csv[POVMESH_CSV_MAX];
-    samplemap_record rec;
-    size_t csv_len = 0;
-    const size_t len = povmesh_format_ray(e, r, text, &rec, e->has_csv ? csv : NULL, &csv_len);
-    return povmesh_append(e, text, len, &rec, csv, csv_len, err);
 }
 
 static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)

@@ -37,17 +37,29 @@ typedef struct povmesh_emitter povmesh_emitter;
 int povmesh_open(povmesh_emitter **e, const camera *c, const char *prefix, const char *csv_path,
                  long long chunk_faces, l2p_error *err);
 
-int povmesh_add(povmesh_emitter *e, const emitted_ray *r, l2p_error *err);
+/* Faces are written in two steps, so that threads can format rays side by side while one of
+   them appends in face order. Formatting reads the emitter and writes only its arguments.
 
-/* povmesh_add in two steps, so that threads can format rays side by side while one of them
-   appends in face order. Formatting reads the emitter and writes only its arguments: the
-   ray's vertex text (at most POVMESH_RAY_TEXT_MAX bytes; returns its length), its sample-map
-   record and, when csv is not NULL, its CSV row (at most POVMESH_CSV_MAX bytes). */
+   Neighbouring rays share a triangle edge where float32 can hold them as well as alone (see
+   povface.h): four vertices for two faces, which POV-Ray parses in two thirds of the time.
+   A face's kind tells the appender where its vertices are. */
+enum {
+    POVMESH_SWAPPED = 1,      /* the face lists its first two vertices in the other order */
+    POVMESH_SHARES_EDGE = 2,  /* its first two vertices are those of the face before */
+    POVMESH_GIVES_EDGE = 4    /* the next face shares its first two vertices */
+};
 enum { POVMESH_RAY_TEXT_MAX = 512, POVMESH_CSV_MAX = 512 };
-size_t povmesh_format_ray(const povmesh_emitter *e, const emitted_ray *r, char *text,
-                          samplemap_record *rec, char *csv, size_t *csv_len);
-int povmesh_append(povmesh_emitter *e, const char *text, size_t len, const samplemap_record *rec,
-                   const char *csv, size_t csv_len, l2p_error *err);
+
+/* Formats n rays, consecutive faces, into text (at most n * POVMESH_RAY_TEXT_MAX bytes;
+   returns its length): len[i] bytes and kind[i] for face i, its sample-map record and, when
+   csv is not NULL, its CSV row (at most POVMESH_CSV_MAX bytes, csv_len[i]). */
+size_t povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n, char *text,
+                           size_t *len, unsigned char *kind, samplemap_record *rec, char *csv,
+                           size_t *csv_len);
+
+/* Appends one face formatted above; faces come in order. */
+int povmesh_append(povmesh_emitter *e, const char *text, size_t len, unsigned kind,
+                   const samplemap_record *rec, const char *csv, size_t csv_len, l2p_error *err);
 bool povmesh_wants_csv(const povmesh_emitter *e);
 
 /* Completes every file and renames them all into place (commit), or removes them; frees e.
@@ -57,8 +69,5 @@ int povmesh_close(povmesh_emitter *e, bool commit, povmesh_chunk_info **chunks, 
 
 void povmesh_free_chunks(povmesh_chunk_info *chunks, int count);
 
-/* The three vertices, relative to a reference point, of the triangle of a ray with origin o
-   and unit direction d, edge scale size: centroid o, POV-Ray normal d. Exposed for tests. */
-void povmesh_triangle(vec3 o, vec3 d, double size, vec3 v[3]);
 
 #endif

@@ -31,6 +31,7 @@ typedef struct row_out {
     char *text;                /* the vertex text of the passed rays, one after the other */
     size_t text_len, text_cap;
     size_t *length;            /* of each passed ray's text */
+    unsigned char *kind;       /* and where its vertices are (POVMESH_SHARES_EDGE, ...) */
     samplemap_record *record;
     char *csv;                 /* their CSV rows, when asked for */
     size_t csv_len, csv_cap, *csv_length;
@@ -44,16 +45,18 @@ static int row_reserve(row_out *o, long long rays, bool csv)
     o->csv_cap = csv ? n * POVMESH_CSV_MAX : 0;
     o->text = malloc(o->text_cap + 1);
     o->length = malloc(n * sizeof *o->length + 1);
+    o->kind = malloc(n + 1);
     o->record = malloc(n * sizeof *o->record + 1);
     o->csv = malloc(o->csv_cap + 1);
     o->csv_length = malloc(n * sizeof *o->csv_length + 1);
-    return o->text && o->length && o->record && o->csv && o->csv_length ? 0 : -1;
+    return o->text && o->length && o->kind && o->record && o->csv && o->csv_length ? 0 : -1;
 }
 
 static void row_free(row_out *o)
 {
     free(o->text);
     free(o->length);
+    free(o->kind);
     free(o->record);
     free(o->csv);
     free(o->csv_length);
@@ -81,19 +84,22 @@ static void flush_batch(const camera *c, const povmesh_emitter *e, batch *b, row
         b->n = 0;
         return;
     }
-    const bool csv = povmesh_wants_csv(e);
+    int n = 0;   /* the passed rays, moved to the front */
     for (int k = 0; k < b->n; k++) {
         if (!b->passed[k])
             continue;
-        b->r[k].out = b->out[k];
-        b->r[k].weight = b->weight[k];
-        const long long i = o->passed++;
-        o->length[i] = povmesh_format_ray(e, &b->r[k], o->text + o->text_len, &o->record[i],
-                                          csv ? o->csv + o->csv_len : NULL, &o->csv_length[i]);
-        o->text_len += o->length[i];
-        if (csv)
-            o->csv_len += o->csv_length[i];
+        b->r[n] = b->r[k];
+        b->r[n].out = b->out[k];
+        b->r[n++].weight = b->weight[k];
     }
+    const long long i = o->passed;
+    const bool csv = povmesh_wants_csv(e);
+    o->text_len += povmesh_format_rays(e, b->r, n, o->text + o->text_len, &o->length[i],
+                                       &o->kind[i], &o->record[i], csv ? o->csv + o->csv_len : NULL,
+                                       &o->csv_length[i]);
+    for (int k = 0; csv && k < n; k++)
+        o->csv_len += o->csv_length[i + k];
+    o->passed += n;
     b->n = 0;
 }
 
@@ -126,8 +132,8 @@ static int append_row(povmesh_emitter *e, const row_out *o, raytable_stats *stat
     size_t at = 0, csv_at = 0;
     for (long long i = 0; i < o->passed; i++) {
         const size_t csv_len = povmesh_wants_csv(e) ? o->csv_length[i] : 0;
-        int st = povmesh_append(e, o->text + at, o->length[i], &o->record[i], o->csv + csv_at,
-                                csv_len, err);
+        int st = povmesh_append(e, o->text + at, o->length[i], o->kind[i], &o->record[i],
+                                o->csv + csv_at, csv_len, err);
         if (st)
             return st;
         at += o->length[i];

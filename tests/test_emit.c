@@ -215,3 +215,67 @@ Test(emit, blocked_rays_are_left_out)
     free(r);
     free(rays);
 }
+
+/* The number in "vertex_vectors { N," of an include. */
+static long vertices_in(const char *path)
+{
+    char *text = read_text(path, NULL);
+    cr_assert_not_null(text, "%s", path);
+    const char *at = strstr(text, "vertex_vectors {");
+    cr_assert_not_null(at, "%s", path);
+    const long n = atol(at + strlen("vertex_vectors {"));
+    free(text);
+    return n;
+}
+
+/* Neighbouring rays share triangle edges (four vertices for two faces). The double-Gauss
+   table must use far fewer than three vertices a face, and when a chunk boundary falls
+   between the two faces of an edge, the second chunk gets the edge's vertices again: every
+   chunk stands alone, and every face still carries its ray. */
+Test(emit, shared_edges_survive_chunk_boundaries)
+{
+    const char *dir = test_tmpdir();
+    size_t n;
+    csv_ray *rows = trace_csv(dir, "dgauss.50mm", "stop-image", &n, NULL, NULL);
+    const long whole = vertices_in(tmp_path(dir, "r.inc"));
+    cr_assert_lt(whole, (long)(2.3 * (double)n), "%ld vertices for %zu faces", whole, n);
+    char *errtext;
+    const char *prefix = tmp_path(dir, "c");
+    /* 0.02 MB: about 100 faces a chunk. */
+    int st = run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--pupil",
+                          "stop-image", "--width", "16", "--height", "12", "--spp", "4",
+                          "--look-at", "0,0,3", "--memory-mb", "0.02", "-o", prefix, "--quiet",
+                          NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    free(errtext);
+    size_t done = 0;
+    long vertices = 0;
+    int chunks = 0;
+    for (;; chunks++) {
+        char path[600];
+        snprintf(path, sizeof path, "%s.c%03d.inc", prefix, chunks);
+        FILE *f = fopen(path, "r");
+        if (!f)
+            break;
+        fclose(f);
+        vertices += vertices_in(path);
+        size_t m;
+        pov_ray *rays = read_include_as_povray(path, &m);
+        cr_assert_leq(done + m, n, "more faces than rays");
+        for (size_t k = 0; k < m; k++, done++) {
+            const vec3 o = v3_scale(rows[done].o, 1e-3);
+            cr_assert_lt(v3_length(v3_sub(rays[k].o, o)), 1e-6, "chunk %d face %zu: origin",
+                         chunks, k);
+            cr_assert_lt(acos(fmin(1.0, v3_dot(rays[k].d, rows[done].d))), 1e-6,
+                         "chunk %d face %zu: direction", chunks, k);
+        }
+        free(rays);
+    }
+    cr_assert_gt(chunks, 4, "%d chunks", chunks);
+    cr_assert_eq(done, n, "every ray in some chunk");
+    /* Each split edge is written twice: two vertices more than the one-chunk table. */
+    cr_assert_gt(vertices, whole, "no chunk boundary split a shared edge: the case is untested");
+    cr_assert_leq(vertices - whole, 2L * (chunks - 1));
+    cr_assert_eq((vertices - whole) % 2, 0);
+    free(rows);
+}

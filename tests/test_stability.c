@@ -11,7 +11,7 @@
    - no non-finite number anywhere: every CSV field, the include's vertex block (digits and
      punctuation only) and translate, and every face as POV-Ray will hold it (float32 vertices,
      the normal of the triangle);
-   - the include is the CSV: each face, read the way POV-Ray reads it, is within 1e-6 of the
+   - the include is the CSV: each face, read the way POV-Ray reads it, is within 1e-5 of the
      lens's size and 1e-5 rad of its CSV row in world space;
    - the emitted rays are the camera's: the same options through cli_parse and camera_setup in
      this process reproduce every sample (camera_trace_batch, the tool's code path, in the
@@ -657,7 +657,9 @@ static void run_case(const stab_case *sc)
     cr_assert_eq(camera_setup(&cam, &l, &c.cam, &err), 0, "%s", err.text);
     check_rays(sc, &cam, rows, nrows, &res);
     /* What POV-Ray will see (float32 vertices, the normal of each triangle) against the CSV
-       in world space: within 1e-6 of the lens's size, and 1e-5 rad. */
+       in world space: within 1e-5 of the lens's size, and 1e-5 rad. A face's vertices lie
+       within 128 lone-triangle sizes (half the widest aperture) of the mesh's origin, so
+       float32 moves its centroid by at most sqrt(3) 2^-24 128 / 2 = 6.6e-6 of the size. */
     size_t nfaces;
     pov_ray *seen = read_include_as_povray(inc, &nfaces);
     const double size_units = lens_size_mm(&cam.lens) / cam.unit_mm;
@@ -668,7 +670,7 @@ static void run_case(const stab_case *sc)
         const double angle = v3_length(v3_sub(seen[k].d, d));
         res.max_pov_pos = fmax(res.max_pov_pos, off);
         res.max_pov_angle = fmax(res.max_pov_angle, angle);
-        cr_expect(off <= 1e-6 && angle <= 1e-5,
+        cr_expect(off <= 1e-5 && angle <= 1e-5,
                   "%s: face %zu is %g of the lens size and %g rad off its CSV row", sc->name, k,
                   off, angle);
     }
