@@ -23,6 +23,7 @@ typedef struct chunk {
     outfile ini;
     long count_offset;      /* where the vertex count goes, filled in at the end */
     long long faces, vertices;
+    bool committed;         /* renamed into place as soon as complete (with a hook) */
     uint8_t *codes;         /* each face's vertex pattern (face_code), four faces a byte */
     size_t codes_cap;
 } chunk;
@@ -47,6 +48,8 @@ struct povmesh_emitter {
     text_out csv;
     bool has_csv;
     long long faces;
+    povmesh_chunk_hook hook;   /* told of each chunk as it is complete; NULL: none */
+    void *hook_ctx;
     char edge_text[POVMESH_RAY_TEXT_MAX];   /* the last shared edge's two vertex lines */
     size_t edge_len;
     vec3 anchor_camera_mm;     /* the front vertex: vertices are written relative to it */
@@ -117,17 +120,28 @@ static int reserve(text_out *t, size_t n, l2p_error *err)
     return t->len + n > BUFFER_BYTES ? flush_text(t, err) : L2P_OK;
 }
 
-static char *chunk_path(const povmesh_emitter *e, int index, const char *ext)
+char *povmesh_chunk_file(const char *prefix, bool chunked, int index, const char *ext)
 {
-    size_t n = strlen(e->prefix) + 32;
+    size_t n = strlen(prefix) + 32;
     char *p = malloc(n);
     if (!p)
         return NULL;
-    if (e->chunk_faces == 0)
-        snprintf(p, n, "%s.%s", e->prefix, ext);
+    if (!chunked)
+        snprintf(p, n, "%s.%s", prefix, ext);
     else
-        snprintf(p, n, "%s.c%03d.%s", e->prefix, index, ext);
+        snprintf(p, n, "%s.c%03d.%s", prefix, index, ext);
     return p;
+}
+
+static char *chunk_path(const povmesh_emitter *e, int index, const char *ext)
+{
+    return povmesh_chunk_file(e->prefix, e->chunk_faces != 0, index, ext);
+}
+
+void povmesh_set_chunk_hook(povmesh_emitter *e, povmesh_chunk_hook hook, void *ctx)
+{
+    e->hook = hook;
+    e->hook_ctx = ctx;
 }
 
 static int open_text(text_out *t, const char *path, l2p_error *err)
@@ -329,9 +343,15 @@ static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)
     if (fseek(t->file.fp, ch->count_offset, SEEK_SET) != 0 ||
         fprintf(t->file.fp, "%*lld", COUNT_FIELD, vertices) != COUNT_FIELD)
         return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "write failed");
-    if ((st = outfile_finish(&t->file, err)) != 0)
+    if ((st = outfile_finish(&t->file, err)) != 0 ||
+        (st = write_ini(e, ch, index, (faces + e->packed_width - 1) / e->packed_width, err)) != 0)
         return st;
-    return write_ini(e, ch, index, (faces + e->packed_width - 1) / e->packed_width, err);
+    if (!e->hook)
+        return L2P_OK;
+    if ((st = outfile_commit(&t->file, err)) != 0 || (st = outfile_commit(&ch->ini, err)) != 0)
+        return st;
+    ch->committed = true;
+    return e->hook(e->hook_ctx, index) ? l2p_fail(err, L2P_FAILED, NULL, 0, "stopped") : L2P_OK;
 }
 
 /* Vertices are written as whole numbers of a quantum of about 1e-8 of the largest coordinate,
@@ -572,7 +592,7 @@ static int commit_all(povmesh_emitter *e, l2p_error *err)
 {
     int st = L2P_OK;
     for (int i = 0; i < e->chunk_count && !st; i++)
-        if (!(st = outfile_commit(&e->chunks[i].inc.file, err)))
+        if (!e->chunks[i].committed && !(st = outfile_commit(&e->chunks[i].inc.file, err)))
             st = outfile_commit(&e->chunks[i].ini, err);
     if (!st && e->has_csv)
         st = outfile_commit(&e->csv.file, err);

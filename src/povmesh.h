@@ -62,6 +62,15 @@ int povmesh_append(povmesh_emitter *e, const char *text, size_t len, unsigned ki
                    const samplemap_record *rec, const char *csv, size_t csv_len, l2p_error *err);
 bool povmesh_wants_csv(const povmesh_emitter *e);
 
+/* Called as each chunk is complete, with its files already renamed into place (not with the
+   others at the end), so that a renderer can start on it while the rest are written. A
+   nonzero return stops the writing: the append or close fails with L2P_FAILED. */
+typedef int (*povmesh_chunk_hook)(void *ctx, int index);
+void povmesh_set_chunk_hook(povmesh_emitter *e, povmesh_chunk_hook hook, void *ctx);
+
+/* The name of a chunk's file: PREFIX.EXT, or PREFIX.cNNN.EXT when chunked (malloc'd). */
+char *povmesh_chunk_file(const char *prefix, bool chunked, int index, const char *ext);
+
 /* Completes every file and renames them all into place (commit), or removes them; frees e.
    After a commit, *chunks (when not NULL) gets the chunks written, owned by the caller. */
 int povmesh_close(povmesh_emitter *e, bool commit, povmesh_chunk_info **chunks, int *count,

@@ -20,9 +20,9 @@
 #include "progress.h"
 
 enum {
-    TICK_MS = 50,
-    DRAW_EVERY_TICKS = 5,      /* redraw the bar 4 times a second */
-    STOP_WAIT_TICKS = 100      /* SIGTERM, then 5 s, then SIGKILL */
+    TICK_MS = 20,
+    DRAW_EVERY_TICKS = 12,     /* redraw the bar 4 times a second */
+    STOP_WAIT_TICKS = 250      /* SIGTERM, then 5 s, then SIGKILL */
 };
 
 /* ---------------------------------------------------------------- small strings and paths */
@@ -94,6 +94,7 @@ typedef struct run {
     int link_count;
     job *jobs;
     int job_slots;
+    bool writing;              /* chunks still being written: their writer draws its own bar */
     progress bar;
 } run;
 
@@ -484,7 +485,7 @@ static int check_finished(const run *r, const job *j, int status, l2p_error *err
 
 static void draw_progress(run *r, int finished)
 {
-    if (!r->bar.enabled)
+    if (!r->bar.enabled || r->writing)
         return;
     double sum = finished;
     int running = 0;
@@ -521,11 +522,29 @@ static int reap_jobs(run *r, int *st, l2p_error *err)
     return ended;
 }
 
+/* How many chunks are ready, and the count once known (r->count shrinks to it). */
+static int poll_chunks(run *r, int *ready, l2p_error *err)
+{
+    if (!r->opts->chunks_ready) {
+        *ready = r->count;
+        return L2P_OK;
+    }
+    int total = -1;
+    const int st = r->opts->chunks_ready(r->opts->ctx, ready, &total, err);
+    if (!st && total > r->count)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "%d chunks written, %d expected", total, r->count);
+    if (!st && total >= 0)
+        r->count = total;
+    r->writing = !st && total < 0;
+    return st;
+}
+
 static int schedule(run *r, l2p_error *err)
 {
-    int next = 0, finished = 0, st = L2P_OK;
+    int next = 0, finished = 0, ready = 0, st = L2P_OK;
     for (int tick = 0; !st && finished < r->count; tick++) {
-        for (int i = 0; i < r->job_slots && next < r->count && !st; i++)
+        st = poll_chunks(r, &ready, err);
+        for (int i = 0; i < r->job_slots && next < ready && !st; i++)
             if (!r->jobs[i].pid)
                 st = start_job(r, &r->jobs[i], next++, err);
         const int ended = st ? 0 : reap_jobs(r, &st, err);

@@ -19,10 +19,15 @@ typedef struct povray_options {
     int threads_per_job;       /* +WTn for each process; 0: POV-Ray's default */
     int show_progress;         /* draw a progress bar on stderr */
     const char *povray;        /* the executable; NULL: "povray" (or $LENS2POV_POVRAY) */
+    /* Chunks still being written (NULL: all are ready): how many are ready now, in order, and
+       in *total the final count once the writer is done (-1 before; at most the count given to
+       povray_render_chunks). Nonzero: the writer failed, with err set. */
+    int (*chunks_ready)(void *ctx, int *ready, int *total, l2p_error *err);
+    void *ctx;
 } povray_options;
 
 /* Writes, for every chunk, a wrapper that includes the scene and then the chunk's camera, and
-   renders them, opts->jobs at a time. On a POV-Ray failure stops the other processes, returns
+   renders them, opts->jobs at a time, each as soon as it is ready (opts->chunks_ready). On a POV-Ray failure stops the other processes, returns
    L2P_FAILED and puts POV-Ray's own error lines (file, line, message) in err. */
 int povray_render_chunks(const povray_chunk *chunks, int count, const povray_options *opts,
                          l2p_error *err);

@@ -260,12 +260,23 @@ int raytable_write(const camera *c, const char *prefix, const char *csv_path,
                    long long chunk_faces, bool show_progress, povmesh_chunk_info **chunks,
                    int *chunk_count, raytable_stats *stats, l2p_error *err)
 {
+    return raytable_write_hooked(c, prefix, csv_path, chunk_faces, show_progress, NULL, NULL,
+                                 chunks, chunk_count, stats, err);
+}
+
+int raytable_write_hooked(const camera *c, const char *prefix, const char *csv_path,
+                          long long chunk_faces, bool show_progress, povmesh_chunk_hook hook,
+                          void *hook_ctx, povmesh_chunk_info **chunks, int *chunk_count,
+                          raytable_stats *stats, l2p_error *err)
+{
     const double start = now_seconds();
     raytable_stats local = {0, 0, 0};
     povmesh_emitter *e;
     int st = povmesh_open(&e, c, prefix, csv_path, chunk_faces, err);
     if (st)
         return st;
+    if (hook)
+        povmesh_set_chunk_hook(e, hook, hook_ctx);
     progress bar;
     progress_start(&bar, "tracing", show_progress);
     st = trace_rows(c, e, &bar, &local, err);

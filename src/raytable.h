@@ -31,4 +31,10 @@ int raytable_write(const camera *c, const char *prefix, const char *csv_path,
                    long long chunk_faces, bool progress, povmesh_chunk_info **chunks,
                    int *chunk_count, raytable_stats *stats, l2p_error *err);
 
+/* raytable_write telling hook of each chunk as it is complete (see povmesh_set_chunk_hook). */
+int raytable_write_hooked(const camera *c, const char *prefix, const char *csv_path,
+                          long long chunk_faces, bool progress, povmesh_chunk_hook hook,
+                          void *hook_ctx, povmesh_chunk_info **chunks, int *chunk_count,
+                          raytable_stats *stats, l2p_error *err);
+
 #endif

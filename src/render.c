@@ -1,6 +1,7 @@
 #include "render.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,8 +41,9 @@ static int number_of_cores(void)
 
 /* Chunks small enough for the memory budget, as many as a multiple of the jobs and with the
    same number of faces, so that the parses, which POV-Ray does on one thread, run side by side
-   and end together (3 chunks on 2 jobs would take two rounds for one and a half chunks' work). */
-static long long chunk_faces_for(const camera *cam, const cli *c, int jobs)
+   and end together (3 chunks on 2 jobs would take two rounds for one and a half chunks' work).
+   Returns the faces a chunk; *chunks gets their number (fewer when there are fewer faces). */
+static long long chunk_faces_for(const camera *cam, const cli *c, int jobs, int *chunks)
 {
     const long long budget = raytable_faces_for_memory(c->memory_mb);
     long long faces = raytable_count_faces(cam);
@@ -49,8 +51,9 @@ static long long chunk_faces_for(const camera *cam, const cli *c, int jobs)
         faces = (long long)(cam->crop_x1 - cam->crop_x0) * (cam->crop_y1 - cam->crop_y0) *
                 cam->samples.spp;
     const long long needed = (faces + budget - 1) / budget;
-    const long long chunks = needed < 1 ? jobs : (needed + jobs - 1) / jobs * jobs;
-    const long long per_chunk = (faces + chunks - 1) / chunks;
+    const long long count = needed < 1 ? jobs : (needed + jobs - 1) / jobs * jobs;
+    const long long per_chunk = (faces + count - 1) / count;
+    *chunks = (int)count;
     return per_chunk > 0 ? per_chunk : 1;
 }
 
@@ -96,74 +99,197 @@ static void remove_workspace(const workspace *w)
     outfile_untrack(w->dir);
 }
 
-static char *chunk_exr_path(const char *include_path)
+/* The ray table is written on a thread of its own, and POV-Ray starts on each chunk as soon as
+   it is complete; the image library (0.3 s to load) loads meanwhile. The writer waits after
+   its first chunk until the library is known to load, so that a run that cannot develop
+   starts no POV-Ray and commits nothing (the --rays CSV). */
+typedef struct writer {
+    const camera *cam;
+    const cli *c;
+    char prefix[8192];
+    long long chunk_faces;
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    int ready, total;          /* chunks complete; their count once done (-1 before) */
+    bool go, stop;             /* from the renderer: the library loaded; stop writing */
+    int status;
+    l2p_error err;
+} writer;
+
+static int chunk_done(void *ctx, int index)
 {
-    char *p = strdup(include_path);
-    if (p)
-        memcpy(p + strlen(p) - 3, "exr", 3);
-    return p;
+    writer *w = ctx;
+    pthread_mutex_lock(&w->lock);
+    w->ready = index + 1;
+    while (!w->go && !w->stop)
+        pthread_cond_wait(&w->changed, &w->lock);
+    const bool stop = w->stop;
+    pthread_mutex_unlock(&w->lock);
+    return stop;
 }
 
-/* POV-Ray on every chunk, then develop. */
-static int render_chunks(const cli *c, const workspace *w, const povmesh_chunk_info *chunks,
-                         int count, int jobs, l2p_error *err)
+static void *write_table(void *arg)
+{
+    writer *w = arg;
+    l2p_error err;
+    povmesh_chunk_info *chunks = NULL;
+    int count = 0;
+    const int st = raytable_write_hooked(w->cam, w->prefix, w->c->rays_csv, w->chunk_faces,
+                                         !w->c->quiet, chunk_done, w, &chunks, &count, NULL, &err);
+    povmesh_free_chunks(chunks, count);
+    pthread_mutex_lock(&w->lock);
+    w->status = st;
+    if (st)
+        w->err = err;
+    w->total = st ? w->ready : count;
+    pthread_mutex_unlock(&w->lock);
+    return NULL;
+}
+
+static int chunks_ready(void *ctx, int *ready, int *total, l2p_error *err)
+{
+    writer *w = ctx;
+    pthread_mutex_lock(&w->lock);
+    *ready = w->ready;
+    *total = w->total;
+    const int st = w->status;
+    if (st)
+        *err = w->err;
+    pthread_mutex_unlock(&w->lock);
+    return st;
+}
+
+static void tell_writer(writer *w, bool go)
+{
+    pthread_mutex_lock(&w->lock);
+    w->go = go;
+    w->stop = !go;
+    pthread_cond_broadcast(&w->changed);
+    pthread_mutex_unlock(&w->lock);
+}
+
+static void *load_image_library(void *arg)
+{
+    (void)arg;
+    image_io_ready(NULL);
+    return NULL;
+}
+
+/* The chunks the writer will write, by name. */
+static povray_chunk *chunk_list(const writer *w, int count, long long faces)
 {
     povray_chunk *pc = calloc((size_t)count, sizeof *pc);
-    const char **exrs = calloc((size_t)count, sizeof *exrs);
-    int st = pc && exrs ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int i = 0; i < count && !st; i++) {
-        pc[i].include_path = chunks[i].include_path;
-        pc[i].ini_path = chunks[i].ini_path;
-        pc[i].faces = chunks[i].faces;
-        pc[i].output_exr = exrs[i] = chunk_exr_path(chunks[i].include_path);
-        if (!exrs[i])
-            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i = 0; pc && i < count; i++) {
+        char *inc = povmesh_chunk_file(w->prefix, true, i, "inc");
+        char *ini = povmesh_chunk_file(w->prefix, true, i, "ini");
+        char *exr = povmesh_chunk_file(w->prefix, true, i, "exr");
+        pc[i] = (povray_chunk){inc, ini, exr, faces};
+        if (!inc || !ini || !exr)
+            return pc;   /* the caller sees the NULL */
     }
-    /* Every process may use every core: the chunks cost the same to parse but not to shade
-       (sky against floor), and a process left shading alone then gets the idle cores. With a
-       core each, bench.pov took 8.0-9.0 s against 6.9-7.5 s (four turns, 2 cores). */
-    const povray_options po = {c->positional[0], w->dir, jobs, number_of_cores(), !c->quiet, NULL};
-    if (!st)
-        st = povray_render_chunks(pc, count, &po, err);
-    char map_path[8192];
-    snprintf(map_path, sizeof map_path, "%s/rays.map", w->dir);
+    return pc;
+}
+
+static void free_chunk_list(povray_chunk *pc, int count)
+{
+    for (int i = 0; pc && i < count; i++) {
+        free((char *)pc[i].include_path);
+        free((char *)pc[i].ini_path);
+        free((char *)pc[i].output_exr);
+    }
+    free(pc);
+}
+
+static bool chunk_list_complete(const povray_chunk *pc, int count)
+{
+    for (int i = 0; pc && i < count; i++)
+        if (!pc[i].include_path || !pc[i].ini_path || !pc[i].output_exr)
+            return false;
+    return pc != NULL;
+}
+
+/* Every chunk's EXR developed into the output through the writer's sample map. */
+static int develop_chunks(const cli *c, const writer *w, const povray_chunk *pc, int count,
+                          l2p_error *err)
+{
+    const char **exrs = calloc((size_t)(count > 0 ? count : 1), sizeof *exrs);
+    if (!exrs)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i = 0; i < count; i++)
+        exrs[i] = pc[i].output_exr;
+    char map_path[8300];
+    snprintf(map_path, sizeof map_path, "%s.map", w->prefix);
     samplemap map;
-    if (!st && !(st = samplemap_read(map_path, &map, err))) {
+    int st = samplemap_read(map_path, &map, err);
+    if (!st) {
         st = develop_files(&map, exrs, count, c->output, err);
         samplemap_free(&map);
     }
-    for (int i = 0; exrs && i < count; i++)
-        free((char *)exrs[i]);
     free(exrs);
-    free(pc);
+    return st;
+}
+
+/* Writes the table and renders its chunks side by side, then develops them. */
+static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
+                            l2p_error *err)
+{
+    writer w = {.cam = cam, .c = c, .total = -1};
+    snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
+    int count;
+    w.chunk_faces = chunk_faces_for(cam, c, jobs, &count);
+    povray_chunk *pc = chunk_list(&w, count, w.chunk_faces);
+    if (!chunk_list_complete(pc, count)) {
+        free_chunk_list(pc, count);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
+    pthread_mutex_init(&w.lock, NULL);
+    pthread_cond_init(&w.changed, NULL);
+    pthread_t thread;
+    int st = pthread_create(&thread, NULL, write_table, &w) == 0
+                 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
+    if (!st) {
+        st = image_io_ready(err);
+        tell_writer(&w, st == L2P_OK);
+        /* Every process may use every core: the chunks cost the same to parse but not to shade
+           (sky against floor), and a process left shading alone then gets the idle cores. */
+        const povray_options po = {c->positional[0], ws->dir, jobs, number_of_cores(),
+                                   !c->quiet, NULL, chunks_ready, &w};
+        if (!st)
+            st = povray_render_chunks(pc, count, &po, err);
+        if (st)
+            tell_writer(&w, false);
+        pthread_join(thread, NULL);
+        if (!st && w.status)   /* failed after its last chunk: the map or the CSV */
+            st = l2p_fail(err, w.status, NULL, 0, "%s", w.err.text);
+        if (!st)
+            st = develop_chunks(c, &w, pc, w.total, err);
+    }
+    pthread_cond_destroy(&w.changed);
+    pthread_mutex_destroy(&w.lock);
+    free_chunk_list(pc, count);
     return st;
 }
 
 int render_command(const cli *c, l2p_error *err)
 {
     int st = check_inputs(c, err);
-    camera cam;
-    if (st || (st = image_io_ready(err)))   /* before the long work that needs it at the end */
+    if (st)
         return st;
     lens l;
     if ((st = lens_read(c->positional[1], &l, err)))
         return st;
+    camera cam;
     if ((st = camera_setup(&cam, &l, &c->cam, err))) {
         camera_free(&cam);
         return st;
     }
+    pthread_t loader;
+    if (pthread_create(&loader, NULL, load_image_library, NULL) == 0)
+        pthread_detach(loader);   /* image_io_ready waits for it */
     const int jobs = c->jobs > 0 ? c->jobs : number_of_cores();
     workspace w;
-    povmesh_chunk_info *chunks = NULL;
-    int count = 0;
     if (!(st = make_workspace(&w, c, err))) {
-        char prefix[8192];
-        snprintf(prefix, sizeof prefix, "%s/rays", w.dir);
-        st = raytable_write(&cam, prefix, c->rays_csv, chunk_faces_for(&cam, c, jobs), !c->quiet,
-                            &chunks, &count, NULL, err);
-        if (!st)
-            st = render_chunks(c, &w, chunks, count, jobs, err);
-        povmesh_free_chunks(chunks, count);
+        st = trace_and_render(c, &cam, &w, jobs, err);
         remove_workspace(&w);
     }
     camera_free(&cam);

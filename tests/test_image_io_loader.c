@@ -58,9 +58,10 @@ Test(image_io_loader, info_runs_without_the_library)
     free(errtext);
 }
 
-/* render needs the library only to develop, at the very end: it must fail before the trace
-   (which would write the --rays CSV) and POV-Ray (which would report the scene's error). */
-Test(image_io_loader, render_fails_before_tracing)
+/* render needs the library only to develop, at the very end, and loads it while it traces: it
+   must fail before POV-Ray (which would report the scene's error) and commit nothing of the
+   trace (the --rays CSV). */
+Test(image_io_loader, render_fails_before_povray_and_writes_nothing)
 {
     const char *dir = test_tmpdir();
     const char *scene = tmp_path(dir, "s.pov"), *picture = tmp_path(dir, "s.png");
@@ -73,7 +74,7 @@ Test(image_io_loader, render_fails_before_tracing)
     cr_assert(strstr(errtext, "cannot load the image library"), "%s", errtext);
     cr_assert(!strstr(errtext, "s.pov"), "POV-Ray did not run: %s", errtext);
     struct stat s;
-    cr_assert_neq(stat(csv, &s), 0, "no trace ran");
+    cr_assert_neq(stat(csv, &s), 0, "no trace committed");
     cr_assert_neq(stat(picture, &s), 0, "no picture written");
     free(errtext);
 }

@@ -80,7 +80,7 @@ Test(povface, a_pair_carries_both_rays_exactly)
         }
     }
     cr_expect_gt(taken, pairs / 2, "only %d of %d neighbouring pairs share an edge", taken, pairs);
-    cr_log_warn("%d of %d pairs taken, worst normal %.3g", taken, pairs, worst);
+    cr_log_info("%d of %d pairs taken, worst normal %.3g", taken, pairs, worst);
 }
 
 Test(povface, pairs_that_float32_would_spoil_are_refused)

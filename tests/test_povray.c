@@ -115,7 +115,7 @@ static void free_fixture(fixture *fx)
 
 static povray_options options(const char *scene, const char *work_dir, int jobs)
 {
-    return (povray_options){scene, work_dir, jobs, 1, 0, NULL};
+    return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL};
 }
 
 /* ---------------------------------------------------------------- reading the EXR back */

@@ -590,6 +590,40 @@ Test(render, chunks_and_jobs_do_not_change_the_picture)
     remove_dir(dir);
 }
 
+/* POV-Ray starts on the first chunk while the writer is still on the others: the first
+   chunk's wrapper (written just before its POV-Ray starts) is older than the last chunk's
+   include (renamed into place when complete). The second of two chunks of 196,608 samples
+   with their CSV takes the writer a tenth of a second; starting the first POV-Ray takes
+   milliseconds. */
+Test(render, povray_starts_on_a_chunk_while_the_rest_are_written)
+{
+    NEW_DIR(dir);
+    PATH(scene, dir, "flat.pov");
+    PATH(out, dir, "flat.exr");
+    PATH(csv, dir, "rays.csv");
+    PATH(keep, dir, "work");
+    write_text(scene, MODERN "background { rgb 0.5 }\n");
+    char *errtext;
+    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "128", "--height", "96",
+                 "--spp", "16", PLACE, "--jobs", "2", "--rays", csv,
+                 "--keep-temp", keep, "--quiet", "-o", out);
+    cr_assert_eq(st, 0, "%s", errtext);
+    free(errtext);
+    const int chunks = count_entries(keep, "rays.c", NULL, 0) / 3;   /* .inc .ini .exr */
+    cr_assert_eq(chunks, 2, "%d chunks", chunks);
+    char first[600], last[600];
+    snprintf(first, sizeof first, "%s/povray.c000.pov", keep);
+    snprintf(last, sizeof last, "%s/rays.c%03d.inc", keep, chunks - 1);
+    struct stat a, b;
+    cr_assert_eq(stat(first, &a), 0, "%s", first);
+    cr_assert_eq(stat(last, &b), 0, "%s", last);
+    const double started = (double)a.st_mtim.tv_sec + 1e-9 * (double)a.st_mtim.tv_nsec;
+    const double written = (double)b.st_mtim.tv_sec + 1e-9 * (double)b.st_mtim.tv_nsec;
+    cr_expect_lt(started, written, "POV-Ray started %.3f s after the table was complete",
+                 started - written);
+    remove_dir(dir);
+}
+
 /* ---------------------------------------------------------------- old and new scenes */
 
 static double srgb_code(double linear)
