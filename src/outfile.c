@@ -107,7 +107,7 @@ int outfile_open(outfile *f, const char *path, l2p_error *err)
     }
     snprintf(f->temp_path, n, "%s.tmp%ld", path, (long)getpid());
     outfile_track(f->temp_path);
-    f->fp = fopen(f->temp_path, "wb");
+    f->fp = fopen(f->temp_path, "wbe");   /* not inherited by POV-Ray */
     if (!f->fp) {
         int e = errno;
         outfile_discard(f);

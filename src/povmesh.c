@@ -346,6 +346,10 @@ static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)
     if ((st = outfile_finish(&t->file, err)) != 0 ||
         (st = write_ini(e, ch, index, (faces + e->packed_width - 1) / e->packed_width, err)) != 0)
         return st;
+    free(t->buf);   /* a finished chunk needs neither its buffer nor its codes */
+    t->buf = NULL;
+    free(ch->codes);
+    ch->codes = NULL;
     if (!e->hook)
         return L2P_OK;
     if ((st = outfile_commit(&t->file, err)) != 0 || (st = outfile_commit(&ch->ini, err)) != 0)

@@ -531,8 +531,9 @@ static int poll_chunks(run *r, int *ready, l2p_error *err)
     }
     int total = -1;
     const int st = r->opts->chunks_ready(r->opts->ctx, ready, &total, err);
-    if (!st && total > r->count)
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "%d chunks written, %d expected", total, r->count);
+    if (!st && (total > r->count || *ready > r->count))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "%d chunks written, %d expected",
+                        total > *ready ? total : *ready, r->count);
     if (!st && total >= 0)
         r->count = total;
     r->writing = !st && total < 0;
@@ -544,7 +545,7 @@ static int schedule(run *r, l2p_error *err)
     int next = 0, finished = 0, ready = 0, st = L2P_OK;
     for (int tick = 0; !st && finished < r->count; tick++) {
         st = poll_chunks(r, &ready, err);
-        for (int i = 0; i < r->job_slots && next < ready && !st; i++)
+        for (int i = 0; i < r->job_slots && next < ready && next < r->count && !st; i++)
             if (!r->jobs[i].pid)
                 st = start_job(r, &r->jobs[i], next++, err);
         const int ended = st ? 0 : reap_jobs(r, &st, err);

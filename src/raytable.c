@@ -187,11 +187,13 @@ static void *worker(void *arg)
 }
 
 /* The writer: rows in order as the workers finish them. */
-static int write_rows(shared *sh, povmesh_emitter *e, progress *bar, raytable_stats *stats,
-                      l2p_error *err)
+static int write_rows(shared *sh, povmesh_emitter *e, const atomic_bool *stop, progress *bar,
+                      raytable_stats *stats, l2p_error *err)
 {
     int st = L2P_OK;
     for (int py = sh->first_row; py < sh->end_row && !st; py++) {
+        if (stop && atomic_load(stop))
+            return l2p_fail(err, L2P_FAILED, NULL, 0, "stopped");
         const int k = (py - sh->first_row) % sh->slots;
         pthread_mutex_lock(&sh->lock);
         while (sh->ready_row[k] != py && !sh->abort)
@@ -216,8 +218,8 @@ static int number_of_workers(void)
     return n < 1 ? 1 : n > 16 ? 16 : (int)n;
 }
 
-static int trace_rows(const camera *c, povmesh_emitter *e, progress *bar, raytable_stats *stats,
-                      l2p_error *err)
+static int trace_rows(const camera *c, povmesh_emitter *e, const atomic_bool *stop, progress *bar,
+                      raytable_stats *stats, l2p_error *err)
 {
     const int workers = number_of_workers();
     shared sh = {.cam = c, .emitter = e, .next_row = c->crop_y0, .end_row = c->crop_y1,
@@ -240,7 +242,7 @@ static int trace_rows(const camera *c, povmesh_emitter *e, progress *bar, raytab
     if (!st && started == 0)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
     if (!st)
-        st = write_rows(&sh, e, bar, stats, err);
+        st = write_rows(&sh, e, stop, bar, stats, err);
     pthread_mutex_lock(&sh.lock);
     sh.abort = true;
     pthread_cond_broadcast(&sh.changed);
@@ -260,14 +262,14 @@ int raytable_write(const camera *c, const char *prefix, const char *csv_path,
                    long long chunk_faces, bool show_progress, povmesh_chunk_info **chunks,
                    int *chunk_count, raytable_stats *stats, l2p_error *err)
 {
-    return raytable_write_hooked(c, prefix, csv_path, chunk_faces, show_progress, NULL, NULL,
-                                 chunks, chunk_count, stats, err);
+    return raytable_write_streamed(c, prefix, csv_path, chunk_faces, show_progress, NULL, chunks,
+                                   chunk_count, stats, err);
 }
 
-int raytable_write_hooked(const camera *c, const char *prefix, const char *csv_path,
-                          long long chunk_faces, bool show_progress, povmesh_chunk_hook hook,
-                          void *hook_ctx, povmesh_chunk_info **chunks, int *chunk_count,
-                          raytable_stats *stats, l2p_error *err)
+int raytable_write_streamed(const camera *c, const char *prefix, const char *csv_path,
+                            long long chunk_faces, bool show_progress, const raytable_stream *stream,
+                            povmesh_chunk_info **chunks, int *chunk_count, raytable_stats *stats,
+                            l2p_error *err)
 {
     const double start = now_seconds();
     raytable_stats local = {0, 0, 0};
@@ -275,11 +277,11 @@ int raytable_write_hooked(const camera *c, const char *prefix, const char *csv_p
     int st = povmesh_open(&e, c, prefix, csv_path, chunk_faces, err);
     if (st)
         return st;
-    if (hook)
-        povmesh_set_chunk_hook(e, hook, hook_ctx);
+    if (stream)
+        povmesh_set_chunk_hook(e, stream->chunk_done, stream->ctx);
     progress bar;
     progress_start(&bar, "tracing", show_progress);
-    st = trace_rows(c, e, &bar, &local, err);
+    st = trace_rows(c, e, stream ? stream->stop : NULL, &bar, &local, err);
     progress_finish(&bar);
     int close_st = povmesh_close(e, st == L2P_OK, chunks, chunk_count, err);
     local.seconds = now_seconds() - start;

@@ -2,6 +2,7 @@
 #ifndef LENS2POV_RAYTABLE_H
 #define LENS2POV_RAYTABLE_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include "camera.h"
 #include "povmesh.h"
@@ -31,10 +32,17 @@ int raytable_write(const camera *c, const char *prefix, const char *csv_path,
                    long long chunk_faces, bool progress, povmesh_chunk_info **chunks,
                    int *chunk_count, raytable_stats *stats, l2p_error *err);
 
-/* raytable_write telling hook of each chunk as it is complete (see povmesh_set_chunk_hook). */
-int raytable_write_hooked(const camera *c, const char *prefix, const char *csv_path,
-                          long long chunk_faces, bool progress, povmesh_chunk_hook hook,
-                          void *hook_ctx, povmesh_chunk_info **chunks, int *chunk_count,
-                          raytable_stats *stats, l2p_error *err);
+/* For a renderer that starts on each chunk as it is complete: told of each chunk (see
+   povmesh_set_chunk_hook), and stopped between rows when *stop becomes true (L2P_FAILED). */
+typedef struct raytable_stream {
+    povmesh_chunk_hook chunk_done;
+    void *ctx;
+    const atomic_bool *stop;
+} raytable_stream;
+
+int raytable_write_streamed(const camera *c, const char *prefix, const char *csv_path,
+                            long long chunk_faces, bool progress, const raytable_stream *stream,
+                            povmesh_chunk_info **chunks, int *chunk_count, raytable_stats *stats,
+                            l2p_error *err);
 
 #endif

@@ -2,6 +2,7 @@
 
 #include <errno.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -100,18 +101,16 @@ static void remove_workspace(const workspace *w)
 }
 
 /* The ray table is written on a thread of its own, and POV-Ray starts on each chunk as soon as
-   it is complete; the image library (0.3 s to load) loads meanwhile. The writer waits after
-   its first chunk until the library is known to load, so that a run that cannot develop
-   starts no POV-Ray and commits nothing (the --rays CSV). */
+   it is complete; the image library (0.3 s to load) loads meanwhile. The --rays CSV is
+   written in the workspace and handed to the user only when the render succeeds. */
 typedef struct writer {
     const camera *cam;
     const cli *c;
-    char prefix[8192];
+    char prefix[8192], csv[8300];
     long long chunk_faces;
     pthread_mutex_t lock;
-    pthread_cond_t changed;
     int ready, total;          /* chunks complete; their count once done (-1 before) */
-    bool go, stop;             /* from the renderer: the library loaded; stop writing */
+    atomic_bool stop;          /* from the renderer: stop at the next row */
     int status;
     l2p_error err;
 } writer;
@@ -121,11 +120,8 @@ static int chunk_done(void *ctx, int index)
     writer *w = ctx;
     pthread_mutex_lock(&w->lock);
     w->ready = index + 1;
-    while (!w->go && !w->stop)
-        pthread_cond_wait(&w->changed, &w->lock);
-    const bool stop = w->stop;
     pthread_mutex_unlock(&w->lock);
-    return stop;
+    return atomic_load(&w->stop);
 }
 
 static void *write_table(void *arg)
@@ -134,8 +130,10 @@ static void *write_table(void *arg)
     l2p_error err;
     povmesh_chunk_info *chunks = NULL;
     int count = 0;
-    const int st = raytable_write_hooked(w->cam, w->prefix, w->c->rays_csv, w->chunk_faces,
-                                         !w->c->quiet, chunk_done, w, &chunks, &count, NULL, &err);
+    const raytable_stream stream = {chunk_done, w, &w->stop};
+    const int st = raytable_write_streamed(w->cam, w->prefix, w->c->rays_csv ? w->csv : NULL,
+                                           w->chunk_faces, !w->c->quiet, &stream, &chunks, &count,
+                                           NULL, &err);
     povmesh_free_chunks(chunks, count);
     pthread_mutex_lock(&w->lock);
     w->status = st;
@@ -159,14 +157,6 @@ static int chunks_ready(void *ctx, int *ready, int *total, l2p_error *err)
     return st;
 }
 
-static void tell_writer(writer *w, bool go)
-{
-    pthread_mutex_lock(&w->lock);
-    w->go = go;
-    w->stop = !go;
-    pthread_cond_broadcast(&w->changed);
-    pthread_mutex_unlock(&w->lock);
-}
 
 static void *load_image_library(void *arg)
 {
@@ -229,12 +219,55 @@ static int develop_chunks(const cli *c, const writer *w, const povray_chunk *pc,
     return st;
 }
 
+/* The workspace's CSV into the user's (opened at the start, so that a bad path fails at
+   once): renamed onto its temporary name, or copied when on another file system; then
+   committed. */
+static int publish_csv(const char *from, outfile *out, l2p_error *err)
+{
+    if (rename(from, out->temp_path) != 0) {
+        if (errno != EXDEV)
+            return l2p_fail(err, L2P_FAILED, out->final_path, 0, "cannot write: %s",
+                            strerror(errno));
+        FILE *in = fopen(from, "rb");
+        if (!in)
+            return l2p_fail(err, L2P_FAILED, from, 0, "cannot read: %s", strerror(errno));
+        char buf[1 << 16];
+        int st = L2P_OK;
+        for (size_t n; !st && (n = fread(buf, 1, sizeof buf, in)) > 0;)
+            if (fwrite(buf, 1, n, out->fp) != n)
+                st = l2p_fail(err, L2P_FAILED, out->final_path, 0, "write failed");
+        if (!st && ferror(in))
+            st = l2p_fail(err, L2P_FAILED, from, 0, "read failed");
+        fclose(in);
+        if (st)
+            return st;
+    }
+    return outfile_commit(out, err);
+}
+
+/* Starts a thread with SIGINT, SIGTERM and SIGHUP blocked, so that they reach the main thread,
+   whose handler stops the POV-Ray processes it tracks. */
+static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
+{
+    sigset_t block, old;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigaddset(&block, SIGHUP);
+    pthread_sigmask(SIG_BLOCK, &block, &old);
+    const int r = pthread_create(t, NULL, fn, arg);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return r;
+}
+
 /* Writes the table and renders its chunks side by side, then develops them. */
 static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
-                            l2p_error *err)
+                            outfile *csv, l2p_error *err)
 {
     writer w = {.cam = cam, .c = c, .total = -1};
     snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
+    snprintf(w.csv, sizeof w.csv, "%s/rays.csv", ws->dir);
+    atomic_init(&w.stop, false);
     int count;
     w.chunk_faces = chunk_faces_for(cam, c, jobs, &count);
     povray_chunk *pc = chunk_list(&w, count, w.chunk_faces);
@@ -243,13 +276,11 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
     pthread_mutex_init(&w.lock, NULL);
-    pthread_cond_init(&w.changed, NULL);
     pthread_t thread;
-    int st = pthread_create(&thread, NULL, write_table, &w) == 0
+    int st = start_thread(&thread, write_table, &w) == 0
                  ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
     if (!st) {
         st = image_io_ready(err);
-        tell_writer(&w, st == L2P_OK);
         /* Every process may use every core: the chunks cost the same to parse but not to shade
            (sky against floor), and a process left shading alone then gets the idle cores. */
         const povray_options po = {c->positional[0], ws->dir, jobs, number_of_cores(),
@@ -257,14 +288,15 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         if (!st)
             st = povray_render_chunks(pc, count, &po, err);
         if (st)
-            tell_writer(&w, false);
+            atomic_store(&w.stop, true);
         pthread_join(thread, NULL);
         if (!st && w.status)   /* failed after its last chunk: the map or the CSV */
             st = l2p_fail(err, w.status, NULL, 0, "%s", w.err.text);
         if (!st)
             st = develop_chunks(c, &w, pc, w.total, err);
+        if (!st && c->rays_csv)
+            st = publish_csv(w.csv, csv, err);
     }
-    pthread_cond_destroy(&w.changed);
     pthread_mutex_destroy(&w.lock);
     free_chunk_list(pc, count);
     return st;
@@ -284,14 +316,17 @@ int render_command(const cli *c, l2p_error *err)
         return st;
     }
     pthread_t loader;
-    if (pthread_create(&loader, NULL, load_image_library, NULL) == 0)
+    if (start_thread(&loader, load_image_library, NULL) == 0)
         pthread_detach(loader);   /* image_io_ready waits for it */
     const int jobs = c->jobs > 0 ? c->jobs : number_of_cores();
     workspace w;
-    if (!(st = make_workspace(&w, c, err))) {
-        st = trace_and_render(c, &cam, &w, jobs, err);
+    outfile csv = {0};
+    if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
+        !(st = make_workspace(&w, c, err))) {
+        st = trace_and_render(c, &cam, &w, jobs, &csv, err);
         remove_workspace(&w);
     }
+    outfile_discard(&csv);   /* nothing when committed */
     camera_free(&cam);
     return st;
 }

@@ -441,6 +441,39 @@ Test(render, syntax_error_fails_cleanly)
     remove_dir(dir);
 }
 
+/* POV-Ray fails on the first chunk while the writer is still on the others (--jobs 1, 32
+   chunks): the writer stops, nothing is left in TMPDIR or beside the scene, and the --rays
+   file that was there before is untouched (the CSV is only handed over when the render
+   succeeds). */
+Test(render, failure_while_the_table_is_written_loses_nothing)
+{
+    NEW_DIR(dir);
+    PATH(scene, dir, "typo.pov");
+    PATH(csv, dir, "rays.csv");
+    PATH(out, dir, "bad.png");
+    write_text(scene, MODERN "sphere { <0, 0, 0>, 1 pigmnt { rgb 1 } }\n");
+    write_text(csv, "an older file\n");
+    const char *tmp = fresh_tmpdir();
+    char *errtext;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "128", "--height",
+                       "96", "--spp", "16", PLACE, "--jobs", "1", "--memory-mb", "1",
+                       "--rays", csv, "--quiet", "-o", out);
+    cr_expect_eq(st, 1, "exit status %d: %s", st, errtext);
+    cr_expect_not_null(strstr(errtext, "pigmnt"), "POV-Ray's message is missing:\n%s", errtext);
+    free(errtext);
+    char *old = read_text(csv, NULL);
+    cr_expect_str_eq(old, "an older file\n", "the --rays file was replaced");
+    free(old);
+    cr_expect_not(exists(out), "an output was written");
+    char listing[2048];
+    cr_expect_eq(count_entries(tmp, NULL, listing, sizeof listing), 0,
+                 "temporary files left in TMPDIR: %s", listing);
+    cr_expect_eq(count_entries(dir, NULL, listing, sizeof listing), 2,
+                 "files left beside the scene: %s", listing);
+    remove_dir(tmp);
+    remove_dir(dir);
+}
+
 /* A scene whose last block is never closed: POV-Ray only notices it in the text that follows,
    which is lens2pov's camera include (deleted by then). The message must still send the user
    to the scene, not to a temporary file of lens2pov's. */
