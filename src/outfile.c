@@ -84,6 +84,16 @@ static void remove_tracked_and_die(int sig)
     raise(sig);
 }
 
+void outfile_block_signals(sigset_t *old)
+{
+    sigset_t block;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigaddset(&block, SIGHUP);
+    pthread_sigmask(SIG_BLOCK, &block, old);
+}
+
 void outfile_install_signal_cleanup(void)
 {
     struct sigaction sa;

@@ -4,6 +4,7 @@
 #ifndef LENS2POV_OUTFILE_H
 #define LENS2POV_OUTFILE_H
 
+#include <signal.h>
 #include <stdio.h>
 #include <sys/types.h>
 #include "error.h"
@@ -37,6 +38,11 @@ void outfile_discard(outfile *f);
    for removal on a signal. */
 void outfile_track(const char *temp_path);
 void outfile_untrack(const char *temp_path);
+
+/* Blocks, in the calling thread, the signals whose handler removes the tracked paths
+   (SIGINT, SIGTERM, SIGHUP), and gives the mask before in *old: for a fork that must track its
+   child first, and for threads that must leave the handler to the main thread. */
+void outfile_block_signals(sigset_t *old);
 
 /* Child processes to terminate (SIGTERM, then wait) before the handler removes the files. */
 void outfile_track_child(pid_t pid);

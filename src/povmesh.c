@@ -4,38 +4,20 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "facelist.h"
 #include "outfile.h"
 #include "povface.h"
 #include "samplemap.h"
 
-enum { BUFFER_BYTES = 1 << 20, MAX_PACKED_WIDTH = 1024, COUNT_FIELD = 20 };
-
-/* Text written through a large buffer with a hand-made fixed-point formatter: printf's %g
-   costs several times the rest of the ray's work. */
-typedef struct text_out {
-    outfile file;
-    char *buf;
-    size_t len;
-} text_out;
+enum { MAX_PACKED_WIDTH = 1024, COUNT_FIELD = 20 };
 
 typedef struct chunk {
     text_out inc;
     outfile ini;
     long count_offset;      /* where the vertex count goes, filled in at the end */
-    long long faces, vertices;
+    face_list faces;
     bool committed;         /* renamed into place as soon as complete (with a hook) */
-    uint8_t *codes;         /* each face's vertex pattern (face_code), four faces a byte */
-    size_t codes_cap;
 } chunk;
-
-/* Where a face's vertices are, relative to the vertices written before it (n of them): the
-   face_indices are replayed from these at the end of the chunk. */
-enum face_code {
-    FACE_OWN = 0,           /* <n, n+1, n+2>, three vertices of its own */
-    FACE_OWN_SWAPPED = 1,   /* <n+1, n, n+2> */
-    FACE_SHARED = 2,        /* <n-3, n-2, n>, the edge of the face before and one of its own */
-    FACE_SHARED_SWAPPED = 3 /* <n-2, n-3, n> */
-};
 
 struct povmesh_emitter {
     const camera *cam;
@@ -58,48 +40,6 @@ struct povmesh_emitter {
     double decimal_scale, fixed_limit;   /* quanta per scene unit; |v| written as integers */
 };
 
-static int flush_text(text_out *t, l2p_error *err)
-{
-    if (t->len && fwrite(t->buf, 1, t->len, t->file.fp) != t->len)
-        return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "write failed");
-    t->len = 0;
-    return L2P_OK;
-}
-
-static void put_text(text_out *t, const char *s, size_t n)
-{
-    memcpy(t->buf + t->len, s, n);
-    t->len += n;
-}
-
-static void put_str(text_out *t, const char *s) { put_text(t, s, strlen(s)); }
-
-static const char DIGIT_PAIRS[] =
-    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
-    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
-    "8081828384858687888990919293949596979899";
-
-/* Writes v in decimal, two digits a step. */
-static void put_uint(text_out *t, uint64_t v)
-{
-    char tmp[24];
-    int n = 0;
-    while (v >= 100) {
-        const unsigned r = (unsigned)(v % 100);
-        v /= 100;
-        tmp[n++] = DIGIT_PAIRS[2 * r + 1];
-        tmp[n++] = DIGIT_PAIRS[2 * r];
-    }
-    if (v >= 10) {
-        tmp[n++] = DIGIT_PAIRS[2 * v + 1];
-        tmp[n++] = DIGIT_PAIRS[2 * v];
-    } else {
-        tmp[n++] = (char)('0' + v);
-    }
-    while (n)
-        t->buf[t->len++] = tmp[--n];
-}
-
 /* v in quanta of 10^-decimals scene units, as an integer rounded half away from zero; the
    mesh's scale turns quanta back into scene units. Past the range of exact integers, %.9g. */
 static void put_number(text_out *t, const povmesh_emitter *e, double v)
@@ -112,12 +52,7 @@ static void put_number(text_out *t, const povmesh_emitter *e, double v)
     const uint64_t k = (uint64_t)(fabs(quanta) + 0.5);
     if (v < 0 && k != 0)
         t->buf[t->len++] = '-';
-    put_uint(t, k);
-}
-
-static int reserve(text_out *t, size_t n, l2p_error *err)
-{
-    return t->len + n > BUFFER_BYTES ? flush_text(t, err) : L2P_OK;
+    text_put_uint(t, k);
 }
 
 char *povmesh_chunk_file(const char *prefix, bool chunked, int index, const char *ext)
@@ -144,22 +79,6 @@ void povmesh_set_chunk_hook(povmesh_emitter *e, povmesh_chunk_hook hook, void *c
     e->hook_ctx = ctx;
 }
 
-static int open_text(text_out *t, const char *path, l2p_error *err)
-{
-    t->len = 0;
-    t->buf = malloc(BUFFER_BYTES + 4096);
-    if (!t->buf)
-        return l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
-    return outfile_open(&t->file, path, err);
-}
-
-static void discard_text(text_out *t)
-{
-    outfile_discard(&t->file);
-    free(t->buf);
-    t->buf = NULL;
-}
-
 static int begin_chunk(povmesh_emitter *e, l2p_error *err)
 {
     chunk *grown = realloc(e->chunks, sizeof *grown * (size_t)(e->chunk_count + 1));
@@ -169,7 +88,7 @@ static int begin_chunk(povmesh_emitter *e, l2p_error *err)
     chunk *ch = &e->chunks[e->chunk_count++];
     memset(ch, 0, sizeof *ch);
     char *path = chunk_path(e, e->chunk_count - 1, "inc");
-    int st = path ? open_text(&ch->inc, path, err) : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    int st = path ? text_open(&ch->inc, path, err) : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     free(path);
     if (st)
         return st;
@@ -192,7 +111,7 @@ static void put_vertex(text_out *t, const povmesh_emitter *e, vec3 v)
     put_number(t, e, v.y);
     t->buf[t->len++] = ',';
     put_number(t, e, v.z);
-    put_text(t, ">,\n", 3);
+    text_put(t, ">,\n", 3);
 }
 
 /* A ray in the mesh's frame: scene units, world axes, relative to the anchor. */
@@ -235,49 +154,6 @@ static int put_faces_of(const povmesh_emitter *e, const emitted_ray *r, int i, i
     return 1;
 }
 
-static void put_index_triple(text_out *t, uint64_t a, uint64_t b, uint64_t c)
-{
-    t->buf[t->len++] = '<';
-    put_uint(t, a);
-    t->buf[t->len++] = ',';
-    put_uint(t, b);
-    t->buf[t->len++] = ',';
-    put_uint(t, c);
-    put_text(t, ">,\n", 3);
-}
-
-static int face_code(const chunk *ch, long long face)
-{
-    return ch->codes[face >> 2] >> (2 * (face & 3)) & 3;
-}
-
-/* The face_indices, replayed from the faces' codes. */
-static int write_faces(text_out *t, const chunk *ch, long long count, l2p_error *err)
-{
-    t->len += (size_t)snprintf(t->buf + t->len, 64, "  }\n  face_indices { %lld,\n", count);
-    uint64_t n = 0;   /* vertices before the face */
-    /* A face takes at most 3 * 20 + 6 bytes; batches of 4096 fit in 4096 * 72. */
-    for (long long done = 0; done < count;) {
-        const long long end = count - done < 4096 ? count : done + 4096;
-        int st = reserve(t, 4096 * 72, err);
-        if (st)
-            return st;
-        for (; done < end; done++) {
-            const int code = ch->codes ? face_code(ch, done) : FACE_OWN;
-            if (code == FACE_OWN || code == FACE_OWN_SWAPPED) {
-                const uint64_t first = code == FACE_OWN ? n : n + 1;
-                put_index_triple(t, first, first == n ? n + 1 : n, n + 2);
-                n += 3;
-            } else {
-                const uint64_t first = code == FACE_SHARED ? n - 3 : n - 2;
-                put_index_triple(t, first, first == n - 3 ? n - 2 : n - 3, n);
-                n += 1;
-            }
-        }
-    }
-    return L2P_OK;
-}
-
 /* The camera: the mesh moved to the lens with a double-precision translate. The mesh is never
    intersected, so it gets no bounding-box tree: "hierarchy off" cuts POV-Ray's parse of the
    table by about a third and its memory by a quarter (measured: 8.2 against 5.1 us a face). */
@@ -285,7 +161,7 @@ static void put_camera(text_out *t, const povmesh_emitter *e)
 {
     const vec3 w = camera_world_from_camera_point(e->cam, e->anchor_camera_mm);
     t->len += (size_t)snprintf(t->buf + t->len, 512,
-        "  }\n  hierarchy off\n}\ncamera {\n  mesh_camera {\n    1 0\n"
+        "  hierarchy off\n}\ncamera {\n  mesh_camera {\n    1 0\n"
         "    mesh { Lens2pov_Rays scale 1e-%d translate <%.17g, %.17g, %.17g> }\n  }\n}\n"
         "#undef Lens2pov_Rays\n"
         "#ifdef (Lens2pov_Version)\n  #version Lens2pov_Version;\n  #undef Lens2pov_Version\n#end\n",
@@ -325,31 +201,29 @@ static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)
 {
     chunk *ch = &e->chunks[index];
     text_out *t = &ch->inc;
-    long long faces = ch->faces, vertices = ch->vertices;
-    int st = reserve(t, 1024, err);
+    int st = text_reserve(t, 1024, err);
     if (st)
         return st;
-    if (faces == 0) {          /* nothing passed the lens: one zero-area face, a ray to nowhere */
-        put_str(t, "<0,0,0>,<0,0,0>,<0,0,0>,\n");
-        faces = 1;
-        vertices = 3;
+    if (ch->faces.faces == 0) {   /* nothing passed the lens: one zero-area face, a ray to nowhere */
+        text_put_str(t, "<0,0,0>,<0,0,0>,<0,0,0>,\n");
+        if (face_list_add(&ch->faces, FACE_OWN))
+            return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "out of memory");
     }
-    st = write_faces(t, ch, faces, err);
-    if (st)
+    text_put_str(t, "  }\n");
+    if ((st = face_list_write(&ch->faces, t, err)) != 0 || (st = text_reserve(t, 1024, err)) != 0)
         return st;
+    text_put_str(t, "  }\n");
     put_camera(t, e);
-    if ((st = flush_text(t, err)) != 0)
+    if ((st = text_flush(t, err)) != 0)
         return st;
     if (fseek(t->file.fp, ch->count_offset, SEEK_SET) != 0 ||
-        fprintf(t->file.fp, "%*lld", COUNT_FIELD, vertices) != COUNT_FIELD)
+        fprintf(t->file.fp, "%*lld", COUNT_FIELD, ch->faces.vertices) != COUNT_FIELD)
         return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "write failed");
-    if ((st = outfile_finish(&t->file, err)) != 0 ||
-        (st = write_ini(e, ch, index, (faces + e->packed_width - 1) / e->packed_width, err)) != 0)
+    const long long rows = (ch->faces.faces + e->packed_width - 1) / e->packed_width;
+    if ((st = outfile_finish(&t->file, err)) != 0 || (st = write_ini(e, ch, index, rows, err)) != 0)
         return st;
-    free(t->buf);   /* a finished chunk needs neither its buffer nor its codes */
-    t->buf = NULL;
-    free(ch->codes);
-    ch->codes = NULL;
+    text_release(t);   /* a finished chunk needs neither its buffer nor its face codes */
+    face_list_free(&ch->faces);
     if (!e->hook)
         return L2P_OK;
     if ((st = outfile_commit(&t->file, err)) != 0 || (st = outfile_commit(&ch->ini, err)) != 0)
@@ -393,14 +267,14 @@ static void choose_layout(povmesh_emitter *e, long long chunk_faces)
 static void free_emitter(povmesh_emitter *e)
 {
     for (int i = 0; i < e->chunk_count; i++) {
-        discard_text(&e->chunks[i].inc);
+        text_discard(&e->chunks[i].inc);
         outfile_discard(&e->chunks[i].ini);
-        free(e->chunks[i].codes);
+        face_list_free(&e->chunks[i].faces);
     }
     free(e->chunks);
     outfile_discard(&e->map);
     if (e->has_csv)
-        discard_text(&e->csv);
+        text_discard(&e->csv);
     free(e->prefix);
     free(e);
 }
@@ -418,9 +292,9 @@ static int open_side_files(povmesh_emitter *e, const char *csv_path, l2p_error *
     if (st || !csv_path)
         return st;
     e->has_csv = true;
-    if ((st = open_text(&e->csv, csv_path, err)) != 0)
+    if ((st = text_open(&e->csv, csv_path, err)) != 0)
         return st;
-    put_str(&e->csv, "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
+    text_put_str(&e->csv, "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
                      "dir_x,dir_y,dir_z,weight\n");
     return L2P_OK;
 }
@@ -482,30 +356,13 @@ size_t povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n
     return t.len;
 }
 
-/* Records face's code, four to a byte. */
-static int push_code(chunk *ch, int code)
-{
-    const size_t byte = (size_t)(ch->faces >> 2);
-    if (byte >= ch->codes_cap) {
-        const size_t cap = ch->codes_cap ? 2 * ch->codes_cap : 4096;
-        uint8_t *grown = realloc(ch->codes, cap);
-        if (!grown)
-            return -1;
-        memset(grown + ch->codes_cap, 0, cap - ch->codes_cap);
-        ch->codes = grown;
-        ch->codes_cap = cap;
-    }
-    ch->codes[byte] |= (uint8_t)(code << (2 * (ch->faces & 3)));
-    return 0;
-}
-
 /* The vertex text of one face, and its code. A face that shares the edge of a face left in
    the previous chunk gets the edge's vertices again. */
 static int put_face(povmesh_emitter *e, chunk *ch, const char *text, size_t len, unsigned kind,
                     l2p_error *err)
 {
-    const bool shares = kind & POVMESH_SHARES_EDGE, alone = shares && ch->faces == 0;
-    int st = reserve(&ch->inc, len + (alone ? e->edge_len : 0), err);
+    const bool shares = kind & POVMESH_SHARES_EDGE, alone = shares && ch->faces.faces == 0;
+    int st = text_reserve(&ch->inc, len + (alone ? e->edge_len : 0), err);
     if (st)
         return st;
     if (kind & POVMESH_GIVES_EDGE) {   /* its first two lines are the edge */
@@ -515,13 +372,12 @@ static int put_face(povmesh_emitter *e, chunk *ch, const char *text, size_t len,
         memcpy(e->edge_text, text, e->edge_len);
     }
     if (alone)
-        put_text(&ch->inc, e->edge_text, e->edge_len);
-    put_text(&ch->inc, text, len);
+        text_put(&ch->inc, e->edge_text, e->edge_len);
+    text_put(&ch->inc, text, len);
     const int swapped = kind & POVMESH_SWAPPED ? 1 : 0;
-    const int code = shares && !alone ? FACE_SHARED + swapped : FACE_OWN + swapped;
-    if (push_code(ch, code))
+    const enum face_code code = shares && !alone ? FACE_SHARED + swapped : FACE_OWN + swapped;
+    if (face_list_add(&ch->faces, code))
         return l2p_fail(err, L2P_FAILED, ch->inc.file.final_path, 0, "out of memory");
-    ch->vertices += code >= FACE_SHARED ? 1 : 3;
     return L2P_OK;
 }
 
@@ -530,22 +386,21 @@ int povmesh_append(povmesh_emitter *e, const char *text, size_t len, unsigned ki
 {
     int st;
     chunk *ch = &e->chunks[e->chunk_count - 1];
-    if (e->chunk_faces && ch->faces == e->chunk_faces) {
+    if (e->chunk_faces && ch->faces.faces == e->chunk_faces) {
         if ((st = end_chunk(e, e->chunk_count - 1, err)) || (st = begin_chunk(e, err)))
             return st;
         ch = &e->chunks[e->chunk_count - 1];
     }
     if ((st = put_face(e, ch, text, len, kind, err)) != 0)
         return st;
-    ch->faces++;
     e->faces++;
     if (samplemap_append(e->map.fp, rec, 1) != 0)
         return l2p_fail(err, L2P_FAILED, e->map.final_path, 0, "write failed");
     if (!e->has_csv)
         return L2P_OK;
-    if ((st = reserve(&e->csv, csv_len, err)) != 0)
+    if ((st = text_reserve(&e->csv, csv_len, err)) != 0)
         return st;
-    put_text(&e->csv, csv, csv_len);
+    text_put(&e->csv, csv, csv_len);
     return L2P_OK;
 }
 
@@ -585,7 +440,7 @@ static int finish_all(povmesh_emitter *e, l2p_error *err)
     fill_map_header(e, &h);
     if (!st && samplemap_finish(e->map.fp, &h) != 0)
         st = l2p_fail(err, L2P_FAILED, e->map.final_path, 0, "write failed");
-    if (!st && e->has_csv && !(st = flush_text(&e->csv, err)))
+    if (!st && e->has_csv && !(st = text_flush(&e->csv, err)))
         st = outfile_finish(&e->csv.file, err);
     if (!st)
         st = outfile_finish(&e->map, err);
@@ -603,36 +458,11 @@ static int commit_all(povmesh_emitter *e, l2p_error *err)
     return st ? st : outfile_commit(&e->map, err);
 }
 
-static int list_chunks(const povmesh_emitter *e, povmesh_chunk_info **out, int *count)
-{
-    povmesh_chunk_info *list = calloc((size_t)e->chunk_count, sizeof *list);
-    if (!list)
-        return L2P_FAILED;
-    for (int i = 0; i < e->chunk_count; i++) {
-        list[i].include_path = chunk_path(e, i, "inc");
-        list[i].ini_path = chunk_path(e, i, "ini");
-        list[i].faces = e->chunks[i].faces;
-    }
-    *out = list;
-    *count = e->chunk_count;
-    return L2P_OK;
-}
-
-int povmesh_close(povmesh_emitter *e, bool commit, povmesh_chunk_info **chunks, int *count,
-                  l2p_error *err)
+int povmesh_close(povmesh_emitter *e, bool commit, int *chunk_count, l2p_error *err)
 {
     int st = L2P_OK;
-    if (commit && !(st = finish_all(e, err)) && !(st = commit_all(e, err)) && chunks)
-        st = list_chunks(e, chunks, count) ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory") : 0;
+    if (commit && !(st = finish_all(e, err)) && !(st = commit_all(e, err)) && chunk_count)
+        *chunk_count = e->chunk_count;
     free_emitter(e);
     return st;
-}
-
-void povmesh_free_chunks(povmesh_chunk_info *chunks, int count)
-{
-    for (int i = 0; i < count; i++) {
-        free(chunks[i].include_path);
-        free(chunks[i].ini_path);
-    }
-    free(chunks);
 }

@@ -23,11 +23,6 @@ typedef struct emitted_ray {
     double weight;
 } emitted_ray;
 
-typedef struct povmesh_chunk_info {
-    char *include_path, *ini_path;
-    long long faces;
-} povmesh_chunk_info;
-
 typedef struct povmesh_emitter povmesh_emitter;
 
 /* Opens the outputs under temporary names. chunk_faces 0: one chunk, written as PREFIX.inc and
@@ -72,11 +67,8 @@ void povmesh_set_chunk_hook(povmesh_emitter *e, povmesh_chunk_hook hook, void *c
 char *povmesh_chunk_file(const char *prefix, bool chunked, int index, const char *ext);
 
 /* Completes every file and renames them all into place (commit), or removes them; frees e.
-   After a commit, *chunks (when not NULL) gets the chunks written, owned by the caller. */
-int povmesh_close(povmesh_emitter *e, bool commit, povmesh_chunk_info **chunks, int *count,
-                  l2p_error *err);
-
-void povmesh_free_chunks(povmesh_chunk_info *chunks, int count);
+   After a commit, *chunk_count (when not NULL) gets the number of chunks written. */
+int povmesh_close(povmesh_emitter *e, bool commit, int *chunk_count, l2p_error *err);
 
 
 #endif

@@ -374,18 +374,14 @@ static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *ol
    handler before any signal can be handled. */
 static pid_t spawn(const run *r, char **argv, int log_fd)
 {
-    sigset_t block, old;
-    sigemptyset(&block);
-    sigaddset(&block, SIGINT);
-    sigaddset(&block, SIGTERM);
-    sigaddset(&block, SIGHUP);
-    sigprocmask(SIG_BLOCK, &block, &old);
+    sigset_t old;
+    outfile_block_signals(&old);
     const pid_t pid = fork();
     if (pid == 0)
         exec_child(r, argv, log_fd, &old);
     if (pid > 0)
         outfile_track_child(pid);
-    sigprocmask(SIG_SETMASK, &old, NULL);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
     return pid;
 }
 

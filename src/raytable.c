@@ -259,17 +259,8 @@ static int trace_rows(const camera *c, povmesh_emitter *e, const atomic_bool *st
 }
 
 int raytable_write(const camera *c, const char *prefix, const char *csv_path,
-                   long long chunk_faces, bool show_progress, povmesh_chunk_info **chunks,
+                   long long chunk_faces, bool show_progress, const raytable_stream *stream,
                    int *chunk_count, raytable_stats *stats, l2p_error *err)
-{
-    return raytable_write_streamed(c, prefix, csv_path, chunk_faces, show_progress, NULL, chunks,
-                                   chunk_count, stats, err);
-}
-
-int raytable_write_streamed(const camera *c, const char *prefix, const char *csv_path,
-                            long long chunk_faces, bool show_progress, const raytable_stream *stream,
-                            povmesh_chunk_info **chunks, int *chunk_count, raytable_stats *stats,
-                            l2p_error *err)
 {
     const double start = now_seconds();
     raytable_stats local = {0, 0, 0};
@@ -283,7 +274,7 @@ int raytable_write_streamed(const camera *c, const char *prefix, const char *csv
     progress_start(&bar, "tracing", show_progress);
     st = trace_rows(c, e, stream ? stream->stop : NULL, &bar, &local, err);
     progress_finish(&bar);
-    int close_st = povmesh_close(e, st == L2P_OK, chunks, chunk_count, err);
+    int close_st = povmesh_close(e, st == L2P_OK, chunk_count, err);
     local.seconds = now_seconds() - start;
     if (stats)
         *stats = local;

@@ -26,12 +26,6 @@ long long raytable_faces_for_memory(double memory_mb);
    them all on every core (about a fifth of the cost of writing them); -1 out of memory. */
 long long raytable_count_faces(const camera *c);
 
-/* Traces crop pixels x spp samples and writes PREFIX.inc/.ini/.map (and csv_path when not
-   NULL); chunk_faces as for povmesh_open. All outputs appear together or not at all. */
-int raytable_write(const camera *c, const char *prefix, const char *csv_path,
-                   long long chunk_faces, bool progress, povmesh_chunk_info **chunks,
-                   int *chunk_count, raytable_stats *stats, l2p_error *err);
-
 /* For a renderer that starts on each chunk as it is complete: told of each chunk (see
    povmesh_set_chunk_hook), and stopped between rows when *stop becomes true (L2P_FAILED). */
 typedef struct raytable_stream {
@@ -40,9 +34,11 @@ typedef struct raytable_stream {
     const atomic_bool *stop;
 } raytable_stream;
 
-int raytable_write_streamed(const camera *c, const char *prefix, const char *csv_path,
-                            long long chunk_faces, bool progress, const raytable_stream *stream,
-                            povmesh_chunk_info **chunks, int *chunk_count, raytable_stats *stats,
-                            l2p_error *err);
+/* Traces crop pixels x spp samples and writes PREFIX.inc/.ini/.map (and csv_path when not
+   NULL); chunk_faces as for povmesh_open. Without a stream, all outputs appear together or
+   not at all. *chunk_count (when not NULL) gets the number of chunks. */
+int raytable_write(const camera *c, const char *prefix, const char *csv_path,
+                   long long chunk_faces, bool progress, const raytable_stream *stream,
+                   int *chunk_count, raytable_stats *stats, l2p_error *err);
 
 #endif

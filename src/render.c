@@ -128,13 +128,10 @@ static void *write_table(void *arg)
 {
     writer *w = arg;
     l2p_error err;
-    povmesh_chunk_info *chunks = NULL;
     int count = 0;
     const raytable_stream stream = {chunk_done, w, &w->stop};
-    const int st = raytable_write_streamed(w->cam, w->prefix, w->c->rays_csv ? w->csv : NULL,
-                                           w->chunk_faces, !w->c->quiet, &stream, &chunks, &count,
-                                           NULL, &err);
-    povmesh_free_chunks(chunks, count);
+    const int st = raytable_write(w->cam, w->prefix, w->c->rays_csv ? w->csv : NULL,
+                                  w->chunk_faces, !w->c->quiet, &stream, &count, NULL, &err);
     pthread_mutex_lock(&w->lock);
     w->status = st;
     if (st)
@@ -157,27 +154,11 @@ static int chunks_ready(void *ctx, int *ready, int *total, l2p_error *err)
     return st;
 }
 
-
 static void *load_image_library(void *arg)
 {
     (void)arg;
     image_io_ready(NULL);
     return NULL;
-}
-
-/* The chunks the writer will write, by name. */
-static povray_chunk *chunk_list(const writer *w, int count, long long faces)
-{
-    povray_chunk *pc = calloc((size_t)count, sizeof *pc);
-    for (int i = 0; pc && i < count; i++) {
-        char *inc = povmesh_chunk_file(w->prefix, true, i, "inc");
-        char *ini = povmesh_chunk_file(w->prefix, true, i, "ini");
-        char *exr = povmesh_chunk_file(w->prefix, true, i, "exr");
-        pc[i] = (povray_chunk){inc, ini, exr, faces};
-        if (!inc || !ini || !exr)
-            return pc;   /* the caller sees the NULL */
-    }
-    return pc;
 }
 
 static void free_chunk_list(povray_chunk *pc, int count)
@@ -190,12 +171,21 @@ static void free_chunk_list(povray_chunk *pc, int count)
     free(pc);
 }
 
-static bool chunk_list_complete(const povray_chunk *pc, int count)
+/* The chunks the writer will write, by name; NULL out of memory. */
+static povray_chunk *chunk_list(const writer *w, int count, long long faces)
 {
-    for (int i = 0; pc && i < count; i++)
-        if (!pc[i].include_path || !pc[i].ini_path || !pc[i].output_exr)
-            return false;
-    return pc != NULL;
+    povray_chunk *pc = calloc((size_t)count, sizeof *pc);
+    for (int i = 0; pc && i < count; i++) {
+        char *inc = povmesh_chunk_file(w->prefix, true, i, "inc");
+        char *ini = povmesh_chunk_file(w->prefix, true, i, "ini");
+        char *exr = povmesh_chunk_file(w->prefix, true, i, "exr");
+        pc[i] = (povray_chunk){inc, ini, exr, faces};
+        if (!inc || !ini || !exr) {
+            free_chunk_list(pc, i + 1);
+            return NULL;
+        }
+    }
+    return pc;
 }
 
 /* Every chunk's EXR developed into the output through the writer's sample map. */
@@ -249,12 +239,8 @@ static int publish_csv(const char *from, outfile *out, l2p_error *err)
    whose handler stops the POV-Ray processes it tracks. */
 static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
 {
-    sigset_t block, old;
-    sigemptyset(&block);
-    sigaddset(&block, SIGINT);
-    sigaddset(&block, SIGTERM);
-    sigaddset(&block, SIGHUP);
-    pthread_sigmask(SIG_BLOCK, &block, &old);
+    sigset_t old;
+    outfile_block_signals(&old);
     const int r = pthread_create(t, NULL, fn, arg);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     return r;
@@ -271,10 +257,8 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     int count;
     w.chunk_faces = chunk_faces_for(cam, c, jobs, &count);
     povray_chunk *pc = chunk_list(&w, count, w.chunk_faces);
-    if (!chunk_list_complete(pc, count)) {
-        free_chunk_list(pc, count);
+    if (!pc)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    }
     pthread_mutex_init(&w.lock, NULL);
     pthread_t thread;
     int st = start_thread(&thread, write_table, &w) == 0

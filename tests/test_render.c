@@ -403,6 +403,18 @@ static const char *fresh_tmpdir(void)
     return tmp;
 }
 
+/* After a failed render: no output, nothing in TMPDIR, and only the files that were there
+   before (beside of them) in the scene's folder. */
+static void expect_nothing_left(const char *tmp, const char *dir, const char *out, int beside)
+{
+    cr_expect_not(exists(out), "an output was written");
+    char listing[2048];
+    cr_expect_eq(count_entries(tmp, NULL, listing, sizeof listing), 0,
+                 "temporary files left in TMPDIR: %s", listing);
+    cr_expect_eq(count_entries(dir, NULL, listing, sizeof listing), beside,
+                 "files left beside the scene: %s", listing);
+}
+
 /* Runs a scene that POV-Ray rejects: exit 1, nothing written, nothing left in TMPDIR or beside
    the scene; returns stderr. */
 static char *render_bad_scene(const char *dir, const char *scene)
@@ -413,12 +425,7 @@ static char *render_bad_scene(const char *dir, const char *scene)
     const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "32", "--height",
                        "24", "--spp", "2", PLACE, "--quiet", "-o", out);
     cr_expect_eq(st, 1, "exit status %d for a scene with a syntax error: %s", st, errtext);
-    cr_expect_not(exists(out), "an output was written");
-    char listing[2048];
-    cr_expect_eq(count_entries(tmp, NULL, listing, sizeof listing), 0,
-                 "temporary files left in TMPDIR: %s", listing);
-    cr_expect_eq(count_entries(dir, NULL, listing, sizeof listing), 1,
-                 "files left beside the scene: %s", listing);
+    expect_nothing_left(tmp, dir, out, 1);
     return errtext;
 }
 
@@ -464,12 +471,7 @@ Test(render, failure_while_the_table_is_written_loses_nothing)
     char *old = read_text(csv, NULL);
     cr_expect_str_eq(old, "an older file\n", "the --rays file was replaced");
     free(old);
-    cr_expect_not(exists(out), "an output was written");
-    char listing[2048];
-    cr_expect_eq(count_entries(tmp, NULL, listing, sizeof listing), 0,
-                 "temporary files left in TMPDIR: %s", listing);
-    cr_expect_eq(count_entries(dir, NULL, listing, sizeof listing), 2,
-                 "files left beside the scene: %s", listing);
+    expect_nothing_left(tmp, dir, out, 2);
     remove_dir(tmp);
     remove_dir(dir);
 }
