@@ -162,7 +162,10 @@ static double centre_mean_weight(const camera *c)
         else
             out = mid;
     }
-    const double rho = in * pupil_ring_radius_mm(&c->pupil, centre), z = c->pupil.z_mm;
+    pupil_shape disk;
+    if (!pupil_shape_at(&c->pupil, 0.0, &disk))
+        return 0.0;
+    const double rho = in * disk.radial_mm, z = c->pupil.z_mm;
     return M_PI * rho * rho / (z * z + rho * rho);
 }
 
@@ -223,9 +226,10 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
         st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->whole, err);
     if (!st)
         st = pupil_make(&c->lens, o->pupil, &c->pupil, err);
-    /* The stop pupil stays the seed's diagnostic; thick tracing blocks nothing to cover. */
+    /* The stop pupil stays the seed's diagnostic, and thick tracing samples the stop's image,
+       as the seed's third variant does: a thick lens blocks nothing. */
     if (!st && o->pupil != PUPIL_STOP && o->trace == TRACE_KIND_FULL)
-        pupil_cover(&c->pupil, &c->lens, 0.5 * c->film.diagonal_mm);
+        pupil_fit(&c->pupil, &c->lens, 0.5 * c->film.diagonal_mm);
     if (!st) {
         double z, r;
         st = pupil_stop_image(&c->lens, false, &z, &r, err);

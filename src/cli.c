@@ -326,3 +326,11 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
     }
     return check_contradictions(c, err);
 }
+
+void cli_warn(const cli *c)
+{
+    if (c->cam.pupil == PUPIL_STOP && c->cam.trace == TRACE_KIND_FULL)
+        fprintf(stderr, "lens2pov: warning: --pupil stop aims at the stop's own disk, which misses "
+                        "rays the lens passes: the picture comes out too dark (a diagnostic; "
+                        "stop-image and rear are unbiased)\n");
+}

@@ -26,4 +26,7 @@ typedef struct cli {
 /* Parses argv[first..argc-1]. */
 int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
 
+/* Warns on stderr about options that give a wrong picture on purpose (--pupil stop). */
+void cli_warn(const cli *c);
+
 #endif

@@ -82,13 +82,15 @@ static int cmd_trace(const cli *c, l2p_error *err)
     int st = need(c, 1, true, err);
     if (st || (st = load_camera(c, c->positional[0], &cam, err)))
         return st;
+    cli_warn(c);
     raytable_stats stats;
     /* One include unless --memory-mb asks for chunks that fit a POV-Ray process each. */
     const long long chunk_faces = c->memory_mb > 0 ? raytable_faces_for_memory(c->memory_mb) : 0;
     st = raytable_write(&cam, c->output, c->rays_csv, chunk_faces, !c->quiet, NULL, NULL, &stats, err);
     if (!st && !c->quiet)
         fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%), %.2f s\n",
-                stats.passed, stats.samples, 100.0 * (double)stats.passed / (double)stats.samples,
+                stats.passed, stats.samples,
+                stats.samples ? 100.0 * (double)stats.passed / (double)stats.samples : 0.0,
                 stats.seconds);
     camera_free(&cam);
     return st;

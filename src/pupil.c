@@ -59,9 +59,8 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err)
         if (st)
             return st;
     }
-    for (int i = 0; i < PUPIL_RINGS; i++)
-        out->ring_radius_mm[i] = out->radius_mm;
-    out->ring_width_mm = 0.0;
+    out->node_spacing_mm = 0.0;
+    out->reach_mm = INFINITY;
     if (!(fabs(out->z_mm) > 1e-9 * (1.0 + out->radius_mm)) || !(out->radius_mm > 0.0))
         return l2p_fail(err, L2P_BAD_INPUT, l->path,
                         l->surface[kind == PUPIL_REAR ? l->count - 1 : l->stop].line,
@@ -70,8 +69,7 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err)
     return L2P_OK;
 }
 
-/* The bodies of concentric_disk and pupil_direction, inlined into pupil_film_rays, which runs
-   for every film sample. */
+/* Shirley and Chiu's concentric map ("A low distortion map between disk and square", 1997). */
 static inline void disk_point(double u, double v, double *x, double *y)
 {
     const double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
@@ -91,65 +89,88 @@ static inline void disk_point(double u, double v, double *x, double *y)
     *y = r * sin(phi);
 }
 
-static inline vec3 direction_toward(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
+void concentric_disk(double u, double v, double *x, double *y) { disk_point(u, v, x, y); }
+
+vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 {
     /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */
     const vec3 d = v3_sub(v3(x_mm, y_mm, pu->z_mm), film_point);
     return v3_normalize(pu->z_mm < 0.0 ? v3_scale(d, -1.0) : d);
 }
 
-/* The ring of film point (x, y): hypot(x, y) / ring_width_mm rounded down, at most
-   PUPIL_RINGS - 1 (also for NaN). hypot is slow. Where the squares neither overflow nor
-   underflow, sqrt(x^2 + y^2) and hypot are both within a few ulps of the exact radius, so
-   when the quotient widened by 1e-12 (relative, thousands of ulps) either side lies in one
-   ring, hypot's lies in it too; only nearer a ring's edge does hypot decide. */
-static inline int ring_index(const pupil *pu, double x, double y)
+bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out)
 {
-    if (!(pu->ring_width_mm > 0.0))
-        return 0;
-    const double r2_mm2 = x * x + y * y;
-    if (r2_mm2 > 0x1p-900 && r2_mm2 < 0x1p900) {
-        const double q = sqrt(r2_mm2) / pu->ring_width_mm;
-        const double low = q * (1.0 - 1e-12), high = q * (1.0 + 1e-12);
-        if (low >= PUPIL_RINGS - 1)
-            return PUPIL_RINGS - 1;
-        if (high < PUPIL_RINGS - 1 && (int)low == (int)high)
-            return (int)low;
+    if (!(r_mm <= pu->reach_mm))
+        return false;
+    if (!(pu->node_spacing_mm > 0.0)) {
+        *out = (pupil_shape){0.0, pu->radius_mm, pu->radius_mm};
+        return true;
     }
-    const double q = hypot(x, y) / pu->ring_width_mm;
-    return q < PUPIL_RINGS - 1 ? (int)q : PUPIL_RINGS - 1;
+    const double t = r_mm / pu->node_spacing_mm;
+    const int j = t < PUPIL_NODES - 1 ? (int)t : PUPIL_NODES - 1;
+    const double f = fmin(t - j, 1.0);
+    const pupil_shape *a = &pu->node[j], *b = &pu->node[j + 1];
+    out->centre_mm = a->centre_mm + f * (b->centre_mm - a->centre_mm);
+    out->radial_mm = a->radial_mm + f * (b->radial_mm - a->radial_mm);
+    out->tangential_mm = a->tangential_mm + f * (b->tangential_mm - a->tangential_mm);
+    return true;
 }
 
-void concentric_disk(double u, double v, double *x, double *y) { disk_point(u, v, x, y); }
-
-vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
+/* The shape for film point p and the unit vector (c, s) from the axis toward p; (1, 0) on the
+   axis, where the shape is a disk about it. */
+static bool shape_for(const pupil *pu, vec3 p, pupil_shape *shape, double *c, double *s)
 {
-    return direction_toward(pu, film_point, x_mm, y_mm);
+    const double r = sqrt(p.x * p.x + p.y * p.y);
+    if (!pupil_shape_at(pu, r, shape))
+        return false;
+    *c = r > 0.0 ? p.x / r : 1.0;
+    *s = r > 0.0 ? p.y / r : 0.0;
+    return true;
 }
 
-double pupil_ring_radius_mm(const pupil *pu, vec3 film_point)
+/* The unit disk's point d goes to centre + M d with M = R diag(radial, tangential) R^T, R the
+   turn by phi: a uniform map onto the ellipse (|det M| = radial tangential is constant) that
+   does not turn d itself, so that a fixed sample moves continuously with the film point, also
+   across the axis, where M tends to a multiple of the identity. */
+bool pupil_point(const pupil *pu, vec3 film_point, double u, double v, double *x_mm,
+                 double *y_mm, double *area_mm2)
 {
-    return pu->ring_radius_mm[ring_index(pu, film_point.x, film_point.y)];
+    pupil_shape e;
+    double c, s, dx, dy;
+    if (!shape_for(pu, film_point, &e, &c, &s))
+        return false;
+    disk_point(u, v, &dx, &dy);
+    const double radial = e.radial_mm * (c * dx + s * dy);
+    const double tangential = e.tangential_mm * (c * dy - s * dx);
+    *x_mm = c * (e.centre_mm + radial) - s * tangential;
+    *y_mm = s * (e.centre_mm + radial) + c * tangential;
+    *area_mm2 = M_PI * e.radial_mm * e.tangential_mm;
+    return true;
 }
 
-/* In passes over the batch, each a short chain of arithmetic per sample, so that the sines,
-   square roots and divisions of different samples overlap. */
+bool pupil_contains(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
+{
+    pupil_shape e;
+    double c, s;
+    if (!shape_for(pu, film_point, &e, &c, &s))
+        return false;
+    const double radial = (c * x_mm + s * y_mm - e.centre_mm) / e.radial_mm;
+    const double tangential = (c * y_mm - s * x_mm) / e.tangential_mm;
+    return radial * radial + tangential * tangential <= 1.0;
+}
+
 void pupil_film_rays(const pupil *pu, int n, const vec3 *film_points, const double *u,
                      const double *v, vec3 *directions, double *weights)
 {
-    for (int k = 0; k < n; k++) {            /* the points on the unit disk, kept in directions */
-        double x, y;
-        disk_point(u[k], v[k], &x, &y);
-        directions[k] = v3(x, y, 0.0);
-    }
-    for (int k = 0; k < n; k++)              /* the radii of the rings, kept in weights */
-        weights[k] = pu->ring_radius_mm[ring_index(pu, film_points[k].x, film_points[k].y)];
     for (int k = 0; k < n; k++) {
-        const double radius = weights[k];
-        directions[k] = direction_toward(pu, film_points[k], directions[k].x * radius,
-                                         directions[k].y * radius);
+        double x, y, area;
+        if (!pupil_point(pu, film_points[k], u[k], v[k], &x, &y, &area)) {
+            directions[k] = v3(0.0, 0.0, 1.0);
+            weights[k] = 0.0;
+            continue;
+        }
+        directions[k] = pupil_direction(pu, film_points[k], x, y);
         const double cos_theta = directions[k].z;
-        const double area = M_PI * radius * radius;
         weights[k] = area * (cos_theta * cos_theta) * (cos_theta * cos_theta) / (pu->z_mm * pu->z_mm);
     }
 }

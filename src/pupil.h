@@ -1,8 +1,9 @@
-/* Exit pupils (seed section III): the disk on the film side toward which film rays are aimed,
-   and sampling it. */
+/* Exit pupils (Kolb, Mitchell and Hanrahan 1995, section 3.3): the region of a plane on the
+   film side toward which film rays are aimed, and sampling it. */
 #ifndef LENS2POV_PUPIL_H
 #define LENS2POV_PUPIL_H
 
+#include <math.h>
 #include <stdbool.h>
 #include "error.h"
 #include "lens.h"
@@ -14,17 +15,27 @@ typedef enum pupil_kind {
     PUPIL_STOP_IMAGE   /* the paraxial image of the stop through the stop-to-film surfaces */
 } pupil_kind;
 
-/* Rings of film radius over which a pupil's disk may grow (see pupil_cover). */
-enum { PUPIL_RINGS = 16 };
+/* The region sampled for one film radius, in the frame where the film point lies on the +x
+   axis: the ellipse of semi-axes radial_mm (along x) and tangential_mm (along y) centred at
+   (centre_mm, 0) of the pupil plane. The lens is rotationally symmetric, so the film point
+   (r cos phi, r sin phi) samples this ellipse turned by phi. */
+typedef struct pupil_shape {
+    double centre_mm, radial_mm, tangential_mm;
+} pupil_shape;
+
+/* Film radii at which the shapes are tabulated, from 0 to the largest film radius. */
+enum { PUPIL_NODES = 48 };
 
 typedef struct pupil {
     pupil_kind kind;
-    double z_mm;        /* plane of the disk, camera space; may lie behind the film (z < 0) */
-    double radius_mm;   /* the model's radius */
-    /* The radius sampled for film points in ring i, i.e. at film radius in
-       [i, i + 1) * ring_width_mm; the last ring extends to infinity. */
-    double ring_radius_mm[PUPIL_RINGS];
-    double ring_width_mm;
+    double z_mm;        /* plane of the sampled region, camera space; may lie behind the film */
+    double radius_mm;   /* the model's disk: the stop, the rear rim or the stop's paraxial image */
+    /* With node_spacing_mm = 0 every film point samples the model's disk. Otherwise film radius
+       r samples the shape interpolated linearly between node[j] and node[j + 1], j = r /
+       node_spacing_mm (the last node beyond), and a film point farther out than reach_mm
+       samples nothing: no ray from it gets through the lens. */
+    double node_spacing_mm, reach_mm;
+    pupil_shape node[PUPIL_NODES + 1];
 } pupil;
 
 /* Name as used on the command line: "stop", "rear", "stop-image". */
@@ -36,26 +47,43 @@ int pupil_kind_parse(const char *name, pupil_kind *k);
 int pupil_stop_image(const lens *l, bool toward_film, double *z_mm, double *radius_mm,
                      l2p_error *err);
 
-/* Builds the pupil for the lens at its current film distance and stop opening; every ring
-   samples the model's disk. */
+/* Builds the pupil for the lens at its current film distance and stop opening: every film
+   point samples the model's disk. */
 int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err);
 
 /* Shirley and Chiu's concentric map of the unit square onto the unit disk: it keeps strata
    compact and areas proportional. */
 void concentric_disk(double u, double v, double *x, double *y);
 
-/* Grows each ring's disk, never shrinking it, until it holds every point of the pupil plane
-   through which a film ray of that ring gets through the lens (full simulation). A disk that
-   misses some of them biases the picture dark: the paraxial image of the stop is about 4%
-   too small in radius on the double-Gauss at f/2, and off axis the bundle shifts. Rays aimed
-   at the extra area are blocked by the trace, and the weight uses the area sampled, so the
-   estimate stays unbiased. film_radius_mm: the largest film radius used. */
-void pupil_cover(pupil *pu, const lens *l, double film_radius_mm);
+/* Fits the sampled region to the rays the lens passes (full simulation), for every film
+   radius up to film_radius_mm. For each node the passing region of the pupil plane is found
+   by bisecting its boundary in many directions; stop-image then samples the ellipse around
+   it, rear the disk about the axis that holds it and the rear rim. Between nodes the
+   interpolated shape is checked against the region at intermediate radii and grown where it
+   falls short; every shape finally gets a small margin (pupil_bounds.c says why it is
+   enough). A region sampled larger than the passing one costs blocked samples, never bias:
+   the weight uses the area sampled. */
+void pupil_fit(pupil *pu, const lens *l, double film_radius_mm);
+
+/* The shape sampled for a film point at film radius r_mm (the frame of pupil_shape); false
+   when no ray from there gets through the lens. */
+bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out);
+
+/* Whether film point p samples anything: false beyond the lens's reach (no ray from p gets
+   through), where a sample would only be traced to be blocked. */
+static inline bool pupil_reaches(const pupil *pu, vec3 film_point)
+{
+    return film_point.x * film_point.x + film_point.y * film_point.y <= pu->reach_mm * pu->reach_mm;
+}
+
+/* Whether point (x, y) of the pupil plane lies in the region sampled for film point p. */
+bool pupil_contains(const pupil *pu, vec3 film_point, double x_mm, double y_mm);
 
 /* The film ray from film point p toward the pupil point of sample (u, v), and the seed's
-   weight A cos^4(theta) / Z^2 (A: area of the disk sampled for p's ring, Z: axial distance
-   from the film to the pupil).
-   Returns the weight; 0 when the pupil lies in the film plane. */
+   weight A cos^4(theta) / Z^2 (A: area of the region sampled for p, Z: axial distance from
+   the film to the pupil plane). The unit square maps onto the region by the concentric map,
+   then the affine map of the unit disk onto the ellipse, so samples are uniform over it.
+   Returns the weight; 0 when the pupil lies in the film plane or p is beyond the reach. */
 double pupil_film_ray(const pupil *pu, vec3 film_point, double u, double v, vec3 *direction);
 
 /* The same for n film samples at once, faster: directions[k] and weights[k] are what
@@ -63,9 +91,12 @@ double pupil_film_ray(const pupil *pu, vec3 film_point, double u, double v, vec3
 void pupil_film_rays(const pupil *pu, int n, const vec3 *film_points, const double *u,
                      const double *v, vec3 *directions, double *weights);
 
-/* The unit direction from film point p toward point (x, y) of the pupil plane, and the radius
-   of the disk sampled for p. */
+/* The unit direction from film point p toward point (x, y) of the pupil plane. */
 vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm);
-double pupil_ring_radius_mm(const pupil *pu, vec3 film_point);
+
+/* The pupil-plane point of sample (u, v) for film point p, the region's area, and whether p
+   samples anything. */
+bool pupil_point(const pupil *pu, vec3 film_point, double u, double v, double *x_mm,
+                 double *y_mm, double *area_mm2);
 
 #endif

@@ -111,13 +111,16 @@ static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *
         const sample_pixel pixel = sample_pattern_pixel(&c->samples, px, py);
         for (int k = 0; k < c->samples.spp; k++) {
             const film_sample s = sample_pattern_sample(&c->samples, pixel, k);
+            const vec3 film_point = film_camera_from_raster(&c->film, px + s.offset_x,
+                                                            py + s.offset_y);
+            if (!pupil_reaches(&c->pupil, film_point))
+                continue;   /* no ray from there gets through: not a sample to trace */
             emitted_ray *r = &b->r[b->n];
             r->px = px;
             r->py = py;
             r->offset_x = s.offset_x;
             r->offset_y = s.offset_y;
-            r->film_point = b->film[b->n] =
-                film_camera_from_raster(&c->film, px + s.offset_x, py + s.offset_y);
+            r->film_point = b->film[b->n] = film_point;
             b->u[b->n] = s.pupil_u;
             b->v[b->n] = s.pupil_v;
             if (++b->n == CAMERA_BATCH)

@@ -291,6 +291,7 @@ int render_command(const cli *c, l2p_error *err)
     int st = check_inputs(c, err);
     if (st)
         return st;
+    cli_warn(c);
     lens l;
     if ((st = lens_read(c->positional[1], &l, err)))
         return st;

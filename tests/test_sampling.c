@@ -1,12 +1,11 @@
 /* The per-sample arithmetic made fast (the sample pattern without divisions, the pixel hash
-   once per pixel, the pupil ring without hypot) against the plain formulas it replaces: every
-   sample and every ring must be the same, bit for bit, or seeded renders would change. */
+   once per pixel) against the plain formulas it replaces: every sample must be the same, bit
+   for bit, or seeded renders would change. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 #include "film.h"
-#include "pupil.h"
 
 /* ---- The sample pattern as first written: per-sample pixel hash, % and / by gx. */
 
@@ -111,132 +110,5 @@ Test(sampling, pattern_matches_for_spp_near_the_int_limit)
         for (size_t j = 0; j < sizeof ks / sizeof ks[0]; j++)
             if (ks[j] < p.spp)
                 check_sample(&p, pixel, 3, 4, ks[j]);
-    }
-}
-
-/* ---- The pupil ring: as first written, hypot then fmin. */
-
-static double ref_ring_radius_mm(const pupil *pu, vec3 p)
-{
-    const double r = hypot(p.x, p.y);
-    int ring = pu->ring_width_mm > 0.0 ? (int)fmin(r / pu->ring_width_mm, PUPIL_RINGS - 1) : 0;
-    return pu->ring_radius_mm[ring < 0 ? 0 : ring];
-}
-
-static pupil ringed_pupil(double ring_width_mm, double z_mm)
-{
-    pupil pu;
-    memset(&pu, 0, sizeof pu);
-    pu.kind = PUPIL_STOP_IMAGE;
-    pu.z_mm = z_mm;
-    pu.radius_mm = 1.0;
-    pu.ring_width_mm = ring_width_mm;
-    for (int i = 0; i < PUPIL_RINGS; i++)
-        pu.ring_radius_mm[i] = 1.0 + i;    /* every ring its own radius */
-    return pu;
-}
-
-/* The film ray as first written, from the public pieces. */
-static double ref_film_ray(const pupil *pu, vec3 film_point, double u, double v, vec3 *direction)
-{
-    double dx, dy;
-    concentric_disk(u, v, &dx, &dy);
-    const double radius = ref_ring_radius_mm(pu, film_point);
-    *direction = pupil_direction(pu, film_point, dx * radius, dy * radius);
-    const double cos_theta = direction->z;
-    const double area = M_PI * radius * radius;
-    return area * (cos_theta * cos_theta) * (cos_theta * cos_theta) / (pu->z_mm * pu->z_mm);
-}
-
-/* The same bits, or both NaN (whose payload may follow the operand order the compiler picks). */
-static bool same_double(double a, double b)
-{
-    return memcmp(&a, &b, sizeof a) == 0 || (isnan(a) && isnan(b));
-}
-
-static void check_point(const pupil *pu, vec3 p)
-{
-    const double want = ref_ring_radius_mm(pu, p), got = pupil_ring_radius_mm(pu, p);
-    cr_assert(same_double(want, got), "width %a, point (%a, %a): ring radius %g, hypot gives %g",
-              pu->ring_width_mm, p.x, p.y, got, want);
-    vec3 want_d, got_d;
-    const double want_w = ref_film_ray(pu, p, 0.3, 0.8, &want_d);
-    const double got_w = pupil_film_ray(pu, p, 0.3, 0.8, &got_d);
-    cr_assert(same_double(want_w, got_w) && same_double(want_d.x, got_d.x) &&
-              same_double(want_d.y, got_d.y) && same_double(want_d.z, got_d.z),
-              "width %a, point (%a, %a): film ray differs", pu->ring_width_mm, p.x, p.y);
-}
-
-/* Points on and a few ulps either side of every ring boundary, in several directions. */
-static void check_boundaries(const pupil *pu)
-{
-    const double angles[] = {0.0, 0.1, M_PI / 4, 1.0, M_PI / 2, 2.5, M_PI, 4.0, 5.9};
-    for (int ring = 0; ring <= PUPIL_RINGS + 1; ring++)
-        for (size_t a = 0; a < sizeof angles / sizeof angles[0]; a++) {
-            double r = ring * pu->ring_width_mm;
-            for (int step = 0; step < 8; step++)
-                r = nextafter(r, 0.0);
-            for (int step = 0; step < 17; step++, r = nextafter(r, INFINITY))
-                check_point(pu, v3(r * cos(angles[a]), r * sin(angles[a]), 0.0));
-        }
-}
-
-Test(sampling, pupil_ring_matches_hypot_at_ring_boundaries)
-{
-    const double widths[] = {1.09375, 0.1, 1.0 / 3.0, 2.7, 1e-3, 1e3, 1e-200, 1e200};
-    for (size_t i = 0; i < sizeof widths / sizeof widths[0]; i++) {
-        const pupil pu = ringed_pupil(widths[i], i % 2 ? 25.0 : -12.0);
-        check_boundaries(&pu);
-    }
-}
-
-Test(sampling, pupil_ring_matches_hypot_everywhere_else)
-{
-    const double widths[] = {1.09375, 0.3, 0.0, -1.0, NAN, 5e-324, 1e-300, 1e300, INFINITY};
-    const double odd[] = {0.0, -0.0, 5e-324, 1e-300, 1e-160, 1e-150, 1e150, 1e160, 1e300,
-                          INFINITY, -INFINITY, NAN};
-    for (size_t i = 0; i < sizeof widths / sizeof widths[0]; i++) {
-        const pupil pu = ringed_pupil(widths[i], 40.0);
-        uint64_t h = 42 + i;
-        for (int n = 0; n < 20000; n++) {
-            h = ref_mix64(h);
-            const double x = 40.0 * (ref_unit_double(h) - 0.5), y = 40.0 * (ref_unit_double(ref_mix64(h)) - 0.5);
-            check_point(&pu, v3(x, y, 0.0));
-        }
-        for (size_t a = 0; a < sizeof odd / sizeof odd[0]; a++)
-            for (size_t b = 0; b < sizeof odd / sizeof odd[0]; b++)
-                check_point(&pu, v3(odd[a], odd[b], 0.0));
-    }
-}
-
-/* A batch through pupil_film_rays against ref_film_ray, the formula as first written
-   (pupil_film_ray is now the batch of one, so it cannot serve as the reference), with the
-   disk's centre, its diagonals and both halves of the map among the samples. */
-Test(sampling, pupil_film_rays_match_one_at_a_time)
-{
-    enum { N = 64 };
-    const double z_mm[] = {25.0, -12.0};
-    for (int zi = 0; zi < 2; zi++) {
-        const pupil pu = ringed_pupil(1.09375, z_mm[zi]);
-        vec3 film[N], d[N];
-        double u[N], v[N], w[N];
-        uint64_t h = 7 + (uint64_t)zi;
-        for (int k = 0; k < N; k++) {
-            h = ref_mix64(h);
-            film[k] = v3(30.0 * (ref_unit_double(h) - 0.5), 30.0 * (ref_unit_double(h >> 7) - 0.5), 0.0);
-            u[k] = ref_unit_double(ref_mix64(h));
-            v[k] = ref_unit_double(ref_mix64(h + 1));
-        }
-        u[0] = v[0] = 0.5;                  /* the centre */
-        u[1] = v[1] = 0.25;                 /* a diagonal, |a| = |b| */
-        u[2] = 0.0; v[2] = 1.0;
-        pupil_film_rays(&pu, N, film, u, v, d, w);
-        for (int k = 0; k < N; k++) {
-            vec3 d1;
-            const double w1 = ref_film_ray(&pu, film[k], u[k], v[k], &d1);
-            cr_assert(same_double(w[k], w1) && same_double(d[k].x, d1.x) &&
-                      same_double(d[k].y, d1.y) && same_double(d[k].z, d1.z),
-                      "z %g, sample %d: the batch differs from the single ray", z_mm[zi], k);
-        }
     }
 }
