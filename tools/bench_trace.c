@@ -1,6 +1,8 @@
 /* Benchmarks of the tracer and the ray-table writer (figures, not tests): rays per second of
-   each trace method and pupil on each lens on one core, and bytes and time per ray of
-   writing the include. Medians of five runs. */
+   each trace method and pupil on each lens on one core; the stop-image pupil's passing share,
+   fit time and cost a sample; bytes and time per ray of writing the include. Medians of five
+   runs. */
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,6 +71,8 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
                 for (int k = 0; k < c.samples.spp; k++) {
                     film_sample s = sample_pattern_sample(&c.samples, pixel, k);
                     fp[b] = film_camera_from_raster(&c.film, px + s.offset_x, py + s.offset_y);
+                    if (!pupil_reaches(&c.pupil, fp[b]))
+                        continue;   /* as the ray table does: not a sample */
                     u[b] = s.pupil_u;
                     v[b] = s.pupil_v;
                     if (++b < CAMERA_BATCH)
@@ -86,6 +90,83 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
     printf("%-22s %-11s %-6s %8.2f M samples/s  %5.1f%% pass\n", c.lens.name,
            pupil_kind_name(p), t == TRACE_KIND_THICK ? "thick" : "full", median5(rate) / 1e6,
            100 * passed_fraction);
+    camera_free(&c);
+}
+
+/* The share of samples that pass, over a 35 mm film of 4:3 and at its centre, for the
+   stop-image pupil at the given f-number (NAN: full opening); the time to fit the pupil and
+   the time per sample of the pupil alone (sample to film ray and weight). */
+static void bench_pupil(const char *lens_path, double f_number)
+{
+    lens l;
+    l2p_error err;
+    camera_options o;
+    camera_options_default(&o);
+    o.width = 256;
+    o.height = 192;
+    o.f_number = f_number;
+    o.look_at = v3(0, 0, 10);
+    camera c;
+    if (lens_read(lens_path, &l, &err) || camera_setup(&c, &l, &o, &err)) {
+        printf("%-16s f/%-5g %s\n", l.name ? l.name : lens_path, f_number, err.text);
+        return;
+    }
+    double fit[5], per_sample[5];
+    for (int run = 0; run < 5; run++) {
+        pupil p = c.pupil;
+        const double start = now();
+        pupil_fit(&p, &c.lens, 0.5 * c.film.diagonal_mm);
+        fit[run] = now() - start;
+    }
+    enum { N = 4096 };
+    static vec3 fp[N], d[N];
+    static double u[N], v[N], w[N];
+    uint64_t h = 1;
+    for (int k = 0; k < N; k++) {
+        h = h * 6364136223846793005ULL + 1442695040888963407ULL;
+        fp[k] = film_camera_from_raster(&c.film, (h >> 40) % 256 + 0.5, (h >> 20) % 192 + 0.5);
+        u[k] = (double)((h >> 11) & 0xffff) / 65536.0;
+        v[k] = (double)((h >> 27) & 0xffff) / 65536.0;
+    }
+    for (int run = 0; run < 5; run++) {
+        const double start = now();
+        for (int rep = 0; rep < 50; rep++)
+            pupil_film_rays(&c.pupil, N, fp, u, v, d, w);
+        per_sample[run] = (now() - start) / (50.0 * N);
+    }
+    long long n = 0, passed = 0, cn = 0, cpassed = 0;
+    ray r[CAMERA_BATCH];
+    bool ok[CAMERA_BATCH];
+    for (int py = 0; py < c.film.height; py++)
+        for (int px = 0; px < c.film.width; px += CAMERA_BATCH / 16) {
+            vec3 f[CAMERA_BATCH];
+            double su[CAMERA_BATCH], sv[CAMERA_BATCH], sw[CAMERA_BATCH];
+            int b = 0;
+            for (int k = 0; k < CAMERA_BATCH; k++) {
+                const sample_pixel pixel = sample_pattern_pixel(&c.samples, px + k / 16, py);
+                const film_sample s = sample_pattern_sample(&c.samples, pixel, k % 16);
+                f[b] = film_camera_from_raster(&c.film, px + k / 16 + s.offset_x, py + s.offset_y);
+                su[b] = s.pupil_u;
+                sv[b] = s.pupil_v;
+                b += pupil_reaches(&c.pupil, f[b]);
+            }
+            camera_trace_batch(&c, f, su, sv, b, r, sw, ok);
+            for (int k = 0; k < b; k++)
+                passed += ok[k];
+            n += b;
+        }
+    for (int k = 0; k < 65536; k++) {   /* jittered strata: a regular grid misses the rim */
+        ray rr;
+        double ww;
+        h = h * 6364136223846793005ULL + 1442695040888963407ULL;
+        const double ju = (double)((h >> 11) & 0xffff) / 65536.0, jv = (double)(h >> 48) / 65536.0;
+        cpassed += camera_trace(&c, v3(0, 0, 0), ((k & 255) + ju) / 256.0, ((k >> 8) + jv) / 256.0,
+                                &rr, &ww);
+        cn++;
+    }
+    printf("%-16s f/%-5.3g %5.1f%% pass over the film  %5.1f%% at the centre  fit %5.1f ms  "
+           "%4.0f ns/sample\n", c.lens.name, c.f_number, 100.0 * (double)passed / (double)n,
+           100.0 * (double)cpassed / (double)cn, 1e3 * median5(fit), 1e9 * median5(per_sample));
     camera_free(&c);
 }
 
@@ -142,6 +223,14 @@ int main(int argc, char **argv)
         for (int p = 0; p < 3; p++)
             bench_trace(path, (pupil_kind)p, TRACE_KIND_FULL);
         bench_trace(path, PUPIL_STOP_IMAGE, TRACE_KIND_THICK);
+    }
+    printf("== the stop-image pupil: passing samples, fit time, pupil time per sample\n");
+    for (int i = 0; i < 4; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s.dat", argv[1], lenses[i]);
+        const double f_numbers[] = {NAN, 8.0, 16.0};
+        for (int f = 0; f < 3; f++)
+            bench_pupil(path, f_numbers[f]);
     }
     printf("== writing the ray table (dgauss.50mm, 1024x1024, 1 spp)\n");
     char path[512];
