@@ -719,8 +719,8 @@ static const stab_case CASES[] = {
      "--film-diagonal 0.035 --unit-mm 1 --focus-distance 3", 0, NULL, 0, 0.5, 1.0, false, false},
     {"scale-1e3", "double Gauss scaled by 1e3 (f = 50 m)", lens_dgauss_kilo,
      "--film-diagonal 35000 --unit-mm 1 --focus-distance 3e6", 0, NULL, 0, 0.5, 1.0, false, false},
-    /* The stop-image pupil is the paraxial image of the stop: off axis the real rays aimed at
-       it miss a 1 um stop (pupil aberration), so only the samples near the centre pass. */
+    /* The stop-image pupil is fitted with real rays: it follows a 1 um stop off axis, where
+       the stop's paraxial image misses it (pupil aberration). */
     {"aperture-1um", "aperture 1e-3 mm (stop-image pupil)", lens_dgauss,
      "--aperture-diameter 0.001", 0, NULL, 0, 0.005, 1.0, false, false},
     {"focus-inf", "focus at infinity", lens_dgauss, "--focus-distance inf", 0, NULL, 0, 0.5, 1.0,
