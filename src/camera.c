@@ -165,7 +165,7 @@ static double centre_mean_weight(const camera *c)
     pupil_shape disk;
     if (!pupil_shape_at(&c->pupil, 0.0, &disk))
         return 0.0;
-    const double rho = in * disk.radial_mm, z = c->pupil.z_mm;
+    const double rho = in * disk.radius_mm[0], z = c->pupil.z_mm;
     return M_PI * rho * rho / (z * z + rho * rho);
 }
 

@@ -98,72 +98,129 @@ vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
     return v3_normalize(pu->z_mm < 0.0 ? v3_scale(d, -1.0) : d);
 }
 
-bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out)
+/* The node j and fraction f of film radius r; false beyond the reach. */
+static bool node_of(const pupil *pu, double r_mm, int *j, double *f)
 {
     if (!(r_mm <= pu->reach_mm))
         return false;
+    const double t = r_mm / pu->node_spacing_mm;
+    *j = t < PUPIL_NODES - 1 ? (int)t : PUPIL_NODES - 1;
+    *f = fmin(t - *j, 1.0);
+    return true;
+}
+
+/* The knot i and fraction g of cos(phi), clamped to [-1, 1]. */
+static inline void knot_of(double cos_phi, int *i, double *g)
+{
+    const double t = 0.5 * PUPIL_KNOTS * (1.0 - fmax(-1.0, fmin(1.0, cos_phi)));
+    *i = t < PUPIL_KNOTS - 1 ? (int)t : PUPIL_KNOTS - 1;
+    *g = fmin(t - *i, 1.0);
+}
+
+double pupil_shape_radius_mm(const pupil_shape *e, double cos_phi)
+{
+    int i;
+    double g;
+    knot_of(cos_phi, &i, &g);
+    return e->radius_mm[i] + g * (e->radius_mm[i + 1] - e->radius_mm[i]);
+}
+
+bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out)
+{
     if (!(pu->node_spacing_mm > 0.0)) {
-        *out = (pupil_shape){0.0, pu->radius_mm, pu->radius_mm};
+        if (!(r_mm <= pu->reach_mm))
+            return false;
+        out->centre_mm = 0.0;
+        for (int i = 0; i <= PUPIL_KNOTS; i++)
+            out->radius_mm[i] = pu->radius_mm;
         return true;
     }
-    const double t = r_mm / pu->node_spacing_mm;
-    const int j = t < PUPIL_NODES - 1 ? (int)t : PUPIL_NODES - 1;
-    const double f = fmin(t - j, 1.0);
+    int j;
+    double f;
+    if (!node_of(pu, r_mm, &j, &f))
+        return false;
     const pupil_shape *a = &pu->node[j], *b = &pu->node[j + 1];
     out->centre_mm = a->centre_mm + f * (b->centre_mm - a->centre_mm);
-    out->radial_mm = a->radial_mm + f * (b->radial_mm - a->radial_mm);
-    out->tangential_mm = a->tangential_mm + f * (b->tangential_mm - a->tangential_mm);
+    for (int i = 0; i <= PUPIL_KNOTS; i++)
+        out->radius_mm[i] = a->radius_mm[i] + f * (b->radius_mm[i] - a->radius_mm[i]);
     return true;
 }
 
-/* The shape for film point p and the unit vector (c, s) from the axis toward p; (1, 0) on the
-   axis, where the shape is a disk about it. */
-static bool shape_for(const pupil *pu, vec3 p, pupil_shape *shape, double *c, double *s)
+/* For film point p: the region's centre (cx, cy) in the pupil plane, the unit vector (c, s)
+   from the axis toward p ((1, 0) on the axis, where the region is a disk about it), and the
+   node j and fraction f of p's radius (j = -1: the model's disk). False beyond the reach. */
+static bool locate(const pupil *pu, vec3 p, double *cx, double *cy, double *c, double *s,
+                   int *j, double *f)
 {
     const double r = sqrt(p.x * p.x + p.y * p.y);
-    if (!pupil_shape_at(pu, r, shape))
-        return false;
     *c = r > 0.0 ? p.x / r : 1.0;
     *s = r > 0.0 ? p.y / r : 0.0;
+    if (!(pu->node_spacing_mm > 0.0)) {
+        *j = -1;
+        *cx = *cy = 0.0;
+        return r <= pu->reach_mm;
+    }
+    if (!node_of(pu, r, j, f))
+        return false;
+    const pupil_shape *a = &pu->node[*j], *b = &pu->node[*j + 1];
+    const double centre = a->centre_mm + *f * (b->centre_mm - a->centre_mm);
+    *cx = centre * *c;
+    *cy = centre * *s;
     return true;
 }
 
-/* The unit disk's point d goes to centre + M d with M = R diag(radial, tangential) R^T, R the
-   turn by phi: a uniform map onto the ellipse (|det M| = radial tangential is constant) that
-   does not turn d itself, so that a fixed sample moves continuously with the film point, also
-   across the axis, where M tends to a multiple of the identity. */
-bool pupil_point(const pupil *pu, vec3 film_point, double u, double v, double *x_mm,
-                 double *y_mm, double *area_mm2)
+/* R toward (dx, dy) from the centre ((0, 0): any direction), for film direction (c, s), node
+   j and fraction f: only the two knots either side, of the two nodes either side. */
+static double radius_toward(const pupil *pu, double dx, double dy, double c, double s, int j,
+                            double f)
 {
-    pupil_shape e;
-    double c, s, dx, dy;
-    if (!shape_for(pu, film_point, &e, &c, &s))
+    if (j < 0)
+        return pu->radius_mm;
+    const double length = sqrt(dx * dx + dy * dy);
+    int i;
+    double g;
+    knot_of(length > 0.0 ? (c * dx + s * dy) / length : 1.0, &i, &g);
+    const pupil_shape *a = &pu->node[j], *b = &pu->node[j + 1];
+    const double ra = a->radius_mm[i] + g * (a->radius_mm[i + 1] - a->radius_mm[i]);
+    const double rb = b->radius_mm[i] + g * (b->radius_mm[i + 1] - b->radius_mm[i]);
+    return ra + f * (rb - ra);
+}
+
+/* The disk's point d goes to centre + R(phi) d, phi the angle of d from the film point's
+   direction. The angle of d is kept, so a fixed sample moves continuously with the film
+   point, also across the axis, where R is constant. A sector of the unit disk (area dphi / 2)
+   maps onto one of area R^2 dphi / 2: the density is 1 / (pi R^2). */
+bool pupil_point(const pupil *pu, vec3 film_point, double u, double v, double *x_mm,
+                 double *y_mm, double *inverse_density_mm2)
+{
+    double cx, cy, c, s, f = 0.0, dx, dy;
+    int j;
+    if (!locate(pu, film_point, &cx, &cy, &c, &s, &j, &f))
         return false;
     disk_point(u, v, &dx, &dy);
-    const double radial = e.radial_mm * (c * dx + s * dy);
-    const double tangential = e.tangential_mm * (c * dy - s * dx);
-    *x_mm = c * (e.centre_mm + radial) - s * tangential;
-    *y_mm = s * (e.centre_mm + radial) + c * tangential;
-    *area_mm2 = M_PI * e.radial_mm * e.tangential_mm;
+    const double radius = radius_toward(pu, dx, dy, c, s, j, f);
+    *x_mm = cx + radius * dx;
+    *y_mm = cy + radius * dy;
+    *inverse_density_mm2 = M_PI * radius * radius;
     return true;
 }
 
 bool pupil_contains(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 {
-    pupil_shape e;
-    double c, s;
-    if (!shape_for(pu, film_point, &e, &c, &s))
+    double cx, cy, c, s, f = 0.0;
+    int j;
+    if (!locate(pu, film_point, &cx, &cy, &c, &s, &j, &f))
         return false;
-    const double radial = (c * x_mm + s * y_mm - e.centre_mm) / e.radial_mm;
-    const double tangential = (c * y_mm - s * x_mm) / e.tangential_mm;
-    return radial * radial + tangential * tangential <= 1.0;
+    const double dx = x_mm - cx, dy = y_mm - cy;
+    const double radius = radius_toward(pu, dx, dy, c, s, j, f);
+    return dx * dx + dy * dy <= radius * radius;
 }
 
 void pupil_film_rays(const pupil *pu, int n, const vec3 *film_points, const double *u,
                      const double *v, vec3 *directions, double *weights)
 {
     for (int k = 0; k < n; k++) {
-        double x, y, area;
+        double x, y, area;   /* the inverse density: the area of a uniform region */
         if (!pupil_point(pu, film_points[k], u[k], v[k], &x, &y, &area)) {
             directions[k] = v3(0.0, 0.0, 1.0);
             weights[k] = 0.0;

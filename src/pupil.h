@@ -16,15 +16,20 @@ typedef enum pupil_kind {
 } pupil_kind;
 
 /* The region sampled for one film radius, in the frame where the film point lies on the +x
-   axis: the ellipse of semi-axes radial_mm (along x) and tangential_mm (along y) centred at
-   (centre_mm, 0) of the pupil plane. The lens is rotationally symmetric, so the film point
-   (r cos phi, r sin phi) samples this ellipse turned by phi. */
+   axis: the points (centre_mm, 0) + rho (cos phi, sin phi) with rho <= R(phi), R linear in
+   cos(phi) between radius_mm[i] at cos(phi) = 1 - 2 i / PUPIL_KNOTS, and R(-phi) = R(phi)
+   (the region is symmetric about the x axis). A region shaped like a star about its centre:
+   the image of the stop cut by the images of the element rims. The lens is rotationally
+   symmetric, so the film point (r cos t, r sin t) samples this region turned by t. */
+enum { PUPIL_KNOTS = 32 };
+
 typedef struct pupil_shape {
-    double centre_mm, radial_mm, tangential_mm;
+    double centre_mm;
+    double radius_mm[PUPIL_KNOTS + 1];
 } pupil_shape;
 
 /* Film radii at which the shapes are tabulated, from 0 to the largest film radius. */
-enum { PUPIL_NODES = 48 };
+enum { PUPIL_NODES = 32 };
 
 typedef struct pupil {
     pupil_kind kind;
@@ -57,12 +62,12 @@ void concentric_disk(double u, double v, double *x, double *y);
 
 /* Fits the sampled region to the rays the lens passes (full simulation), for every film
    radius up to film_radius_mm. For each node the passing region of the pupil plane is found
-   by bisecting its boundary in many directions; stop-image then samples the ellipse around
-   it, rear the disk about the axis that holds it and the rear rim. Between nodes the
+   by bisecting its boundary in many directions; stop-image then samples the star-shaped
+   region through that boundary, rear the disk about the axis that holds it and the rear rim. Between nodes the
    interpolated shape is checked against the region at intermediate radii and grown where it
-   falls short; every shape finally gets a small margin (pupil_bounds.c says why it is
-   enough). A region sampled larger than the passing one costs blocked samples, never bias:
-   the weight uses the area sampled. */
+   falls short; every shape finally gets a small margin (pupil_fit.c says why it is enough).
+   A region sampled larger than the passing one costs blocked samples, never bias: the weight
+   divides by the sampling density. */
 void pupil_fit(pupil *pu, const lens *l, double film_radius_mm);
 
 /* The shape sampled for a film point at film radius r_mm (the frame of pupil_shape); false
@@ -79,10 +84,11 @@ static inline bool pupil_reaches(const pupil *pu, vec3 film_point)
 /* Whether point (x, y) of the pupil plane lies in the region sampled for film point p. */
 bool pupil_contains(const pupil *pu, vec3 film_point, double x_mm, double y_mm);
 
-/* The film ray from film point p toward the pupil point of sample (u, v), and the seed's
-   weight A cos^4(theta) / Z^2 (A: area of the region sampled for p, Z: axial distance from
-   the film to the pupil plane). The unit square maps onto the region by the concentric map,
-   then the affine map of the unit disk onto the ellipse, so samples are uniform over it.
+/* The film ray from film point p toward the pupil point of sample (u, v), and its weight
+   cos^4(theta) / (Z^2 q) (Z: axial distance from the film to the pupil plane, q: the density
+   of the pupil point, 1 / A for the seed's uniform disk of area A). The unit square maps onto
+   the unit disk by the concentric map, and the disk's point d onto centre + R(phi) d: the
+   density is 1 / (pi R(phi)^2), uniform where R is constant (a disk).
    Returns the weight; 0 when the pupil lies in the film plane or p is beyond the reach. */
 double pupil_film_ray(const pupil *pu, vec3 film_point, double u, double v, vec3 *direction);
 
@@ -94,9 +100,12 @@ void pupil_film_rays(const pupil *pu, int n, const vec3 *film_points, const doub
 /* The unit direction from film point p toward point (x, y) of the pupil plane. */
 vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm);
 
-/* The pupil-plane point of sample (u, v) for film point p, the region's area, and whether p
-   samples anything. */
+/* The pupil-plane point of sample (u, v) for film point p, the inverse of its density
+   (pi R(phi)^2, in mm^2), and whether p samples anything. */
 bool pupil_point(const pupil *pu, vec3 film_point, double u, double v, double *x_mm,
-                 double *y_mm, double *area_mm2);
+                 double *y_mm, double *inverse_density_mm2);
+
+/* R of shape e for a direction at cos(phi) = cos_phi from its centre. */
+double pupil_shape_radius_mm(const pupil_shape *e, double cos_phi);
 
 #endif

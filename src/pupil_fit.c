@@ -12,25 +12,25 @@
 
 enum {
     DIRECTIONS = 96,   /* boundary points over [0, pi]: DIRECTIONS + 1 of them */
-    BISECTIONS = 36,   /* each halves a bracket; the first is at most the region's size */
+    BISECTIONS = 30,   /* each halves a bracket; the first is at most the region's size */
     DOUBLINGS = 60,    /* a bracket grows at most this often */
     NEAR_TRIES = 64,   /* points either side of the guess on the x axis, a quarter size apart */
     SCAN = 4096,       /* the last-resort scan along the x axis */
-    CHECKS = 3         /* film radii checked between two nodes */
+    CHECKS = 1         /* film radii checked between two nodes */
 };
 
-/* The last growth of every shape. The boundary is bisected to 2^-36 of the region's size, so
-   what the fit can miss lies between two directions: where a vignetted region's top is the
-   stop's nearly flat image and the ellipse curves more, the region's arc bulges past the
-   ellipse through its neighbouring boundary points by about s^2 / 8 (kappa_ellipse -
-   kappa_region) with s the points' spacing. With 48 directions that reached 0.26% on the
-   double-Gauss's film edge; with 96 it is a quarter of that, and 0.4% covers it six times.
-   The region's corners lie on the x axis, where a direction always points. */
+/* The last growth of every shape. The boundary is bisected to 2^-30 of the region's size, so
+   what the fit can miss lies between two of the 97 directions, where the region's arc may
+   bulge past the radius interpolated linearly in the angle: by about s^2 / 8 times the
+   radius's second derivative in the angle, s = pi / 96, a few 1e-4 of the radius for the
+   regions a lens makes. 0.4% holds that several times over, and the fit samples four angles
+   between each two directions as well. */
 static const double MARGIN = 1.004;
 
 typedef struct region {
     bool found;
     double lo_mm, hi_mm;                   /* extent on the x axis */
+    double middle_mm;                      /* where the boundary is seen from, on the x axis */
     double x_mm[DIRECTIONS + 1], y_mm[DIRECTIONS + 1];   /* boundary, y >= 0 */
 } region;
 
@@ -175,6 +175,7 @@ static region find_region(const pupil *pu, const lens *l, double r, double guess
     }
     dx[DIRECTIONS] = -1.0;
     dy[DIRECTIONS] = 0.0;
+    g.middle_mm = middle;
     boundary(pu, l, r, middle, 0.0, dx, dy, DIRECTIONS + 1, 0.125 * (g.hi_mm - g.lo_mm), s);
     for (int k = 0; k <= DIRECTIONS; k++) {
         g.x_mm[k] = middle + s[k] * dx[k];
@@ -183,28 +184,59 @@ static region find_region(const pupil *pu, const lens *l, double r, double guess
     return g;
 }
 
-/* The smallest shape of the pupil's kind that holds the region: for stop-image the ellipse on
-   the region's bounding box, grown until it holds every boundary point; for rear the disk
-   about the axis that holds them and the rear rim. */
+static double size_of(const pupil_shape *e)
+{
+    double size = 0.0;
+    for (int i = 0; i <= PUPIL_KNOTS; i++)
+        size = fmax(size, e->radius_mm[i]);
+    return size;
+}
+
+static pupil_shape disk(double radius_mm)
+{
+    pupil_shape e = {.centre_mm = 0.0};
+    for (int i = 0; i <= PUPIL_KNOTS; i++)
+        e.radius_mm[i] = radius_mm;
+    return e;
+}
+
+/* Raises knots i and i + 1 of e until the shape reaches distance rho at cos(phi) = cos_phi
+   from its centre (the knots' segment holding cos_phi). */
+static void reach_out(pupil_shape *e, double cos_phi, double rho)
+{
+    const double t = 0.5 * PUPIL_KNOTS * (1.0 - fmax(-1.0, fmin(1.0, cos_phi)));
+    const int i = t < PUPIL_KNOTS - 1 ? (int)t : PUPIL_KNOTS - 1;
+    const double short_by = rho - pupil_shape_radius_mm(e, cos_phi);
+    if (short_by > 0.0) {
+        e->radius_mm[i] += short_by;
+        e->radius_mm[i + 1] += short_by;
+    }
+}
+
+/* The shape of the pupil's kind that holds the region. stop-image: the star about the
+   region's middle through its boundary, the radius taken linear in the angle between two
+   boundary directions and sampled four times between them; rear: the disk about the axis
+   holding the boundary and the rear rim. */
 static pupil_shape fit_shape(const pupil *pu, const region *g)
 {
-    double lo = g->lo_mm, hi = g->hi_mm, top = 0.0, far = 0.0;
-    for (int k = 0; k <= DIRECTIONS; k++) {
-        lo = fmin(lo, g->x_mm[k]);
-        hi = fmax(hi, g->x_mm[k]);
-        top = fmax(top, g->y_mm[k]);
-        far = fmax(far, hypot(g->x_mm[k], g->y_mm[k]));
-    }
     if (pu->kind == PUPIL_REAR) {
-        const double radius = fmax(pu->radius_mm, far);
-        return (pupil_shape){0.0, radius, radius};
+        double far = pu->radius_mm;
+        for (int k = 0; k <= DIRECTIONS; k++)
+            far = fmax(far, hypot(g->x_mm[k], g->y_mm[k]));
+        return disk(far);
     }
-    pupil_shape e = {0.5 * (lo + hi), fmax(0.5 * (hi - lo), 1e-300), fmax(top, 1e-300)};
-    double worst = 1.0;
+    double rho[DIRECTIONS + 1];
     for (int k = 0; k <= DIRECTIONS; k++)
-        worst = fmax(worst, hypot((g->x_mm[k] - e.centre_mm) / e.radial_mm, g->y_mm[k] / e.tangential_mm));
-    e.radial_mm *= worst;
-    e.tangential_mm *= worst;
+        rho[k] = hypot(g->x_mm[k] - g->middle_mm, g->y_mm[k]);
+    pupil_shape e = {.centre_mm = g->middle_mm};
+    for (int i = 0; i <= PUPIL_KNOTS; i++) {   /* first through the boundary at the knots */
+        const double t = acos(1.0 - 2.0 * i / PUPIL_KNOTS) / M_PI * DIRECTIONS;
+        const int k = t < DIRECTIONS ? (int)t : DIRECTIONS - 1;
+        e.radius_mm[i] = rho[k] + (t - k) * (rho[k + 1] - rho[k]);
+    }
+    for (int k = 0; k < DIRECTIONS; k++)       /* then out to it between them */
+        for (int q = 0; q <= 4; q++)
+            reach_out(&e, cos(M_PI * (k + q / 4.0) / DIRECTIONS), rho[k] + q / 4.0 * (rho[k + 1] - rho[k]));
     return e;
 }
 
@@ -212,15 +244,19 @@ static pupil_shape fit_shape(const pupil *pu, const region *g)
 static double shortfall(const pupil_shape *e, const region *g)
 {
     double worst = 1.0;
-    for (int k = 0; k <= DIRECTIONS; k++)
-        worst = fmax(worst, hypot((g->x_mm[k] - e->centre_mm) / e->radial_mm, g->y_mm[k] / e->tangential_mm));
+    for (int k = 0; k <= DIRECTIONS; k++) {
+        const double dx = g->x_mm[k] - e->centre_mm, dy = g->y_mm[k];
+        const double rho = hypot(dx, dy);
+        if (rho > 0.0)
+            worst = fmax(worst, rho / pupil_shape_radius_mm(e, dx / rho));
+    }
     return worst;
 }
 
 static void grow(pupil_shape *e, double factor)
 {
-    e->radial_mm *= factor;
-    e->tangential_mm *= factor;
+    for (int i = 0; i <= PUPIL_KNOTS; i++)
+        e->radius_mm[i] *= factor;
 }
 
 /* The nodes' shapes where the region is found; found[j] says where. The guess for each node
@@ -234,13 +270,11 @@ static void fit_nodes(pupil *pu, const lens *l, bool *found)
         if (!g.found)
             continue;
         pu->node[j] = fit_shape(pu, &g);
-        if (j == 0) {   /* on the axis the region is a disk about it */
-            const double radius = fmax(pu->node[0].radial_mm, pu->node[0].tangential_mm);
-            pu->node[0] = (pupil_shape){0.0, radius, radius};
-        }
+        if (j == 0)   /* on the axis the region is a disk about it */
+            pu->node[0] = disk(size_of(&pu->node[0]));
         const double previous = j > 0 && found[j - 1] ? pu->node[j - 1].centre_mm : pu->node[j].centre_mm;
         guess = 2.0 * pu->node[j].centre_mm - previous;
-        size = pu->node[j].radial_mm;
+        size = size_of(&pu->node[j]);
     }
 }
 
@@ -264,9 +298,9 @@ static double find_reach(pupil *pu, const lens *l, const bool *found)
             return INFINITY;
     const pupil_shape *e = &pu->node[last];
     double in = last * pu->node_spacing_mm, out = in + pu->node_spacing_mm;
-    for (int k = 0; k < 40; k++) {
+    for (int k = 0; k < 24; k++) {   /* to 6e-8 of the node spacing */
         const double mid = 0.5 * (in + out);
-        if (find_region(pu, l, mid, e->centre_mm, e->radial_mm).found)
+        if (find_region(pu, l, mid, e->centre_mm, size_of(e)).found)
             in = mid;
         else
             out = mid;
@@ -275,15 +309,14 @@ static double find_reach(pupil *pu, const lens *l, const bool *found)
 }
 
 /* The growth of b alone that grows the shape interpolated at fraction f from a to b by at least
-   factor on both axes: (1 - f) a + f g b >= factor ((1 - f) a + f b). */
+   factor at every knot: (1 - f) a + f g b >= factor ((1 - f) a + f b). */
 static double far_growth(const pupil_shape *a, const pupil_shape *b, double factor, double f)
 {
-    const double radial = 1.0 + (factor - 1.0) * ((1.0 - f) * a->radial_mm + f * b->radial_mm) /
-                                    (f * b->radial_mm);
-    const double tangential = 1.0 + (factor - 1.0) *
-                                        ((1.0 - f) * a->tangential_mm + f * b->tangential_mm) /
-                                        (f * b->tangential_mm);
-    return fmax(radial, tangential);
+    double g = 1.0;
+    for (int i = 0; i <= PUPIL_KNOTS; i++)
+        g = fmax(g, 1.0 + (factor - 1.0) * ((1.0 - f) * a->radius_mm[i] + f * b->radius_mm[i]) /
+                              (f * b->radius_mm[i]));
+    return g;
 }
 
 /* Checks CHECKS film radii between each two nodes (up to the reach) against the shape
@@ -297,7 +330,7 @@ static void check_between(pupil *pu, const lens *l)
             pupil_shape e;
             if (!pupil_shape_at(pu, r, &e))
                 continue;
-            const region g = find_region(pu, l, r, e.centre_mm, e.radial_mm);
+            const region g = find_region(pu, l, r, e.centre_mm, size_of(&e));
             if (!g.found)
                 continue;
             const double factor = shortfall(&e, &g);
@@ -319,7 +352,7 @@ void pupil_fit(pupil *pu, const lens *l, double film_radius_mm)
     bool found[PUPIL_NODES + 1];
     pu->node_spacing_mm = film_radius_mm / PUPIL_NODES;
     for (int j = 0; j <= PUPIL_NODES; j++)
-        pu->node[j] = (pupil_shape){0.0, pu->radius_mm, pu->radius_mm};
+        pu->node[j] = disk(pu->radius_mm);
     fit_nodes(pu, l, found);
     pu->reach_mm = find_reach(pu, l, found);
     check_between(pu, l);

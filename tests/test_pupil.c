@@ -1,4 +1,4 @@
-/* The exit pupils: the map from samples to pupil points (uniform, its area in the weight,
+/* The exit pupils: the map from samples to pupil points (its exact density in the weight,
    continuous over the film), and the physics they must get right: every ray the lens passes
    lies in the sampled region, and the film irradiance of a uniform background matches an
    independent integral over every direction the lens passes. */
@@ -39,9 +39,13 @@ static pupil hand_made(double z_mm)
     pu.radius_mm = 5.0;
     pu.node_spacing_mm = 0.5;
     pu.reach_mm = INFINITY;
-    for (int j = 0; j <= PUPIL_NODES; j++)
-        pu.node[j] = (pupil_shape){0.1 * j - 0.003 * j * j, 5.0 - 0.06 * j, 5.0 + 0.02 * j};
-    pu.node[0] = (pupil_shape){0.0, 5.0, 5.0};
+    for (int j = 0; j <= PUPIL_NODES; j++) {   /* the axis's disk turning into an oval */
+        pu.node[j].centre_mm = 0.1 * j - 0.003 * j * j;
+        for (int i = 0; i <= PUPIL_KNOTS; i++) {
+            const double c = 1.0 - 2.0 * i / PUPIL_KNOTS;
+            pu.node[j].radius_mm[i] = 5.0 - 0.06 * j * c * c + 0.01 * j * c;
+        }
+    }
     return pu;
 }
 
@@ -51,39 +55,42 @@ static void sample_point(const pupil *pu, vec3 p, double u, double v, double *x,
     cr_assert(pupil_point(pu, p, u, v, x, y, &area));
 }
 
-/* The map's Jacobian, by central differences, is the region's area everywhere (the concentric
-   map is uniform, the ellipse's affine map has a constant determinant), and the weight is that
-   area times cos^4 / Z^2. Samples near the concentric map's diagonals, where it is only
-   piecewise smooth, are left out. */
-Test(pupil, samples_are_uniform_and_the_weight_holds_their_area)
+/* The map's Jacobian, by central differences, is the inverse of the density the weight
+   divides by, pi R(phi)^2, with R read off the interpolated shape at the sample's angle from
+   the film point's direction; the weight is that times cos^4 / Z^2. Samples near the
+   concentric map's diagonals, where it is only piecewise smooth, are left out. */
+Test(pupil, the_weight_divides_by_the_exact_density)
 {
     const double z_mm[] = {40.0, -15.0};
     uint64_t state = 1;
     for (int zi = 0; zi < 2; zi++) {
         const pupil pu = hand_made(z_mm[zi]);
         for (int n = 0; n < 2000; n++) {
-            const double r = 24.0 * unit(&state), phi = 2.0 * M_PI * unit(&state);
-            const vec3 p = v3(r * cos(phi), r * sin(phi), 0.0);
+            const double r = 24.0 * unit(&state), t = 2.0 * M_PI * unit(&state);
+            const vec3 p = v3(r * cos(t), r * sin(t), 0.0);
             const double u = 0.02 + 0.96 * unit(&state), v = 0.02 + 0.96 * unit(&state);
             if (fabs(fabs(2 * u - 1) - fabs(2 * v - 1)) < 1e-3)
                 continue;
             const double h = 1e-6;
-            double x1, y1, x2, y2, x3, y3, x4, y4;
+            double x1, y1, x2, y2, x3, y3, x4, y4, x, y, inverse_density;
             sample_point(&pu, p, u + h, v, &x1, &y1);
             sample_point(&pu, p, u - h, v, &x2, &y2);
             sample_point(&pu, p, u, v + h, &x3, &y3);
             sample_point(&pu, p, u, v - h, &x4, &y4);
+            cr_assert(pupil_point(&pu, p, u, v, &x, &y, &inverse_density));
             const double det = ((x1 - x2) * (y3 - y4) - (y1 - y2) * (x3 - x4)) / (4 * h * h);
             pupil_shape e;
             cr_assert(pupil_shape_at(&pu, r, &e));
-            const double area = M_PI * e.radial_mm * e.tangential_mm;
-            cr_assert_float_eq(det, area, 1e-5 * area, "r %g: Jacobian %.9g, area %.9g", r, det, area);
-            double x, y;
-            sample_point(&pu, p, u, v, &x, &y);
+            const double cx = e.centre_mm * cos(t), cy = e.centre_mm * sin(t);
+            const double phi = atan2(y - cy, x - cx) - t;
+            const double radius = pupil_shape_radius_mm(&e, cos(phi));
+            cr_assert_float_eq(inverse_density, M_PI * radius * radius, 1e-9 * inverse_density);
+            cr_assert_float_eq(det, inverse_density, 1e-5 * inverse_density,
+                               "r %g: Jacobian %.9g, pi R^2 %.9g", r, det, inverse_density);
             const vec3 d = v3_normalize(v3_sub(v3(x, y, pu.z_mm), p));
             vec3 got_d;
             const double w = pupil_film_ray(&pu, p, u, v, &got_d);
-            const double want = area * pow(fabs(d.z), 4) / (pu.z_mm * pu.z_mm);
+            const double want = inverse_density * pow(fabs(d.z), 4) / (pu.z_mm * pu.z_mm);
             cr_assert_float_eq(w, want, 1e-12 * want);
             cr_assert(fabs(v3_dot(got_d, d)) > 1 - 1e-15, "the ray aims at the pupil point");
         }
@@ -103,8 +110,8 @@ Test(pupil, a_sample_moves_continuously_with_the_film_point)
             const vec3 p = v3(0.6 * i * step, 0.8 * i * step, 0.0);
             double x, y;
             sample_point(&pu, p, us[k], vs[k], &x, &y);
-            /* The shapes change by at most 0.2 mm per mm of film radius, the turn moves a
-               point on a 10 mm disk by at most 10 mm per radian: 50 mm per mm covers both. */
+            /* The shapes change by at most 0.5 mm per mm of film radius, the turn moves a
+               point of a 12 mm region by at most 12 mm per radian: 50 mm per mm covers both. */
             if (i > -8000)
                 cr_assert_lt(hypot(x - px, y - py), 50.0 * step, "sample %d jumps at film %g mm",
                              k, i * step);
@@ -304,8 +311,9 @@ Test(pupil, irradiance_matches_an_independent_integral_over_the_lens, .timeout =
 /* A dense grid over the rear element, and beyond its rim: every ray from the film point through
    a grid point that the lens passes crosses the pupil plane inside the region sampled for that
    film point (none for a film point beyond the lens's reach). Film points: centre, mid-field,
-   edge, corner (beyond the fisheye's image circle); stops: full, a quarter of the opening,
-   1/16; focus 10 m and 2 m (the telephoto's closest is farther: 4 m). */
+   edge, corner (beyond the fisheye's image circle), and four points on the diagonal that fall
+   between the pupil's nodes; stops: full, a quarter of the opening, 1/16; focus 10 m and 2 m
+   (the telephoto's closest is farther: 4 m). */
 Test(pupil, every_passing_ray_lies_in_the_sampled_region, .timeout = 600)
 {
     const double openings[] = {1.0, 0.25, 1.0 / 16};
@@ -331,8 +339,10 @@ Test(pupil, every_passing_ray_lies_in_the_sampled_region, .timeout = 600)
                     cr_assert_eq(camera_setup(&c, &l, &o, &err), 0, "%s", err.text);
                     const lens_surface *rear = &c.lens.surface[c.lens.count - 1];
                     const double reach = 0.75 * rear->aperture_mm, z = rear->vertex_z_mm;
-                    for (int i = 0; i < POINTS; i++) {
-                        const vec3 p = film_point(&c, i);
+                    for (int i = 0; i < POINTS + 4; i++) {   /* and between the nodes */
+                        const double along[4] = {0.13, 0.37, 0.61, 0.87};
+                        const vec3 p = i < POINTS ? film_point(&c, i)
+                                                  : v3_scale(film_point(&c, 3), along[i - POINTS]);
                         long passing = 0, outside = 0;
                         for (int j = 0; j < N; j++)
                             for (int k = 0; k < N; k++) {
