@@ -402,3 +402,22 @@ Test(pupil, the_stop_pupil_says_it_is_biased)
     cr_assert(strstr(errtext, "warning: --pupil stop") != NULL, "%s", errtext);
     free(errtext);
 }
+
+/* The fisheye's reach is where its image circle ends: a dense grid of directions finds rays
+   that pass half a percent inside it, and none 0.1% beyond it. */
+Test(pupil, the_reach_is_where_the_image_circle_ends)
+{
+    const double f_numbers[] = {NAN, 8.0};
+    for (int fi = 0; fi < 2; fi++) {
+        camera c;
+        setup(&c, "fisheye.10mm", f_numbers[fi], 10.0, PUPIL_STOP_IMAGE);
+        const double reach = c.pupil.reach_mm;
+        cr_assert(reach > 5.0 && reach < 17.5, "f/%g: reach %g mm", f_numbers[fi], reach);
+        const long inside = count_cells(&c.lens, v3(0.995 * reach, 0, 0), -1.0, -1.0, 1.0 / 1024, 2048, NULL);
+        const long beyond = count_cells(&c.lens, v3(1.001 * reach, 0, 0), -1.0, -1.0, 1.0 / 1024, 2048, NULL);
+        cr_assert_gt(inside, 0, "f/%g: nothing passes inside the reach, %g mm", f_numbers[fi], reach);
+        cr_assert_eq(beyond, 0, "f/%g: %ld directions pass beyond the reach, %g mm", f_numbers[fi],
+                     beyond, reach);
+        camera_free(&c);
+    }
+}
