@@ -119,9 +119,10 @@ static double search_half_side_mm(const pupil *pu, const lens *l, double r)
 }
 
 /* A passing point of the x axis: the guess, then points a quarter of size apart either side
-   of it, then (when scan) a scan of the whole useful segment. */
+   of it, then a scan of the whole useful segment (near the reach the region is a sliver that
+   the search near the guess can miss). */
 static bool find_on_axis(const pupil *pu, const lens *l, double r, double guess, double size,
-                         bool scan, double *x)
+                         double *x)
 {
     double xs[2 * NEAR_TRIES + 1], ys[2 * NEAR_TRIES + 1] = {0};
     bool passed[2 * NEAR_TRIES + 1];
@@ -137,7 +138,7 @@ static bool find_on_axis(const pupil *pu, const lens *l, double r, double guess,
             return true;
         }
     const double half = search_half_side_mm(pu, l, r);
-    for (int done = 0; scan && done < SCAN; done += TRACE_SOA_MAX) {
+    for (int done = 0; done < SCAN; done += TRACE_SOA_MAX) {
         double sx[TRACE_SOA_MAX], sy[TRACE_SOA_MAX] = {0};
         bool sp[TRACE_SOA_MAX];
         for (int k = 0; k < TRACE_SOA_MAX; k++)
@@ -152,14 +153,12 @@ static bool find_on_axis(const pupil *pu, const lens *l, double r, double guess,
     return false;
 }
 
-/* The passing region for film radius r, searched from a guess of its centre and size (and,
-   when scan, along the whole x axis). */
-static region find_region(const pupil *pu, const lens *l, double r, double guess, double size,
-                          bool scan)
+/* The passing region for film radius r, searched from a guess of its centre and size. */
+static region find_region(const pupil *pu, const lens *l, double r, double guess, double size)
 {
     region g = {.found = false};
     double x0;
-    if (!(size > 0.0) || !find_on_axis(pu, l, r, guess, size, scan, &x0))
+    if (!(size > 0.0) || !find_on_axis(pu, l, r, guess, size, &x0))
         return g;
     const double ux[2] = {1.0, -1.0}, uy[2] = {0.0, 0.0};
     double t[2];
@@ -267,7 +266,7 @@ static void fit_nodes(pupil *pu, const lens *l, bool *found)
 {
     double guess = 0.0, size = pu->radius_mm;
     for (int j = 0; j <= PUPIL_NODES; j++) {
-        const region g = find_region(pu, l, j * pu->node_spacing_mm, guess, size, true);
+        const region g = find_region(pu, l, j * pu->node_spacing_mm, guess, size);
         found[j] = g.found;
         if (!g.found)
             continue;
@@ -282,8 +281,7 @@ static void fit_nodes(pupil *pu, const lens *l, bool *found)
 
 /* The film radius beyond which nothing passes, when the last nodes find nothing: bisected
    between the last node that finds the region and the first that does not, and at least the
-   radius where the search last found it. Near the reach the region is a sliver that the
-   search near the last one can miss, so the whole axis is scanned there too. Fills the empty nodes with the last found shape;
+   radius where the search last found it. Fills the empty nodes with the last found shape;
    INFINITY when every node or none finds the region, or when one is found after a gap. */
 static double find_reach(pupil *pu, const lens *l, const bool *found)
 {
@@ -303,7 +301,7 @@ static double find_reach(pupil *pu, const lens *l, const bool *found)
     double in = last * pu->node_spacing_mm, out = in + pu->node_spacing_mm;
     for (int k = 0; k < 24; k++) {   /* to 6e-8 of the node spacing */
         const double mid = 0.5 * (in + out);
-        if (find_region(pu, l, mid, e->centre_mm, size_of(e), true).found)
+        if (find_region(pu, l, mid, e->centre_mm, size_of(e)).found)
             in = mid;
         else
             out = mid;
@@ -333,7 +331,7 @@ static void check_between(pupil *pu, const lens *l)
             pupil_shape e;
             if (!pupil_shape_at(pu, r, &e))
                 continue;
-            const region g = find_region(pu, l, r, e.centre_mm, size_of(&e), true);
+            const region g = find_region(pu, l, r, e.centre_mm, size_of(&e));
             if (!g.found)
                 continue;
             const double factor = shortfall(&e, &g);
