@@ -20,8 +20,9 @@ static const char usage[] =
     "  --width N --height N --spp N --film-diagonal MM --crop X0,Y0,X1,Y1\n"
     "  --film-distance MM | --focus-distance UNITS|inf\n"
     "  --aperture-diameter MM | --f-number N\n"
-    "  --pupil stop|rear|stop-image --trace full|thick --weighting normalized|physical\n"
+    "  --pupil stop-image|rear|stop --trace full|thick --weighting normalized|physical\n"
     "  --location X,Y,Z --look-at X,Y,Z --sky X,Y,Z --unit-mm MM --seed N\n"
+    "pupils: stop-image (default) and rear are unbiased; stop is a biased diagnostic.\n"
     "See README.md for the conventions.\n";
 
 static int fail(const l2p_error *err)
