@@ -10,7 +10,10 @@ OPT      ?= -O2
 # -ffp-contract=off: a fused multiply-add rounds once where the code says round twice; the
 # vector lanes and the one-ray kernel agree bit for bit only without it (GCC's gnu11 mode and
 # clang contract by default).
-CFLAGS_BASE   = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE $(OPT) -g -fno-math-errno -ffp-contract=off -Wall -Wextra -Werror
+C_DIALECT     = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -fno-math-errno -ffp-contract=off
+CFLAGS_BASE   = $(C_DIALECT) $(OPT) -g -Wall -Wextra -Werror
+# The sanitizers of make test-sanitize and of the fuzz targets.
+SANITIZERS    = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 CXXFLAGS_BASE = -std=c++17 $(OPT) -g -Wall -Wextra -Werror
 SAN      ?=
 LDLIBS   = -lm -lpthread -ldl
@@ -40,15 +43,17 @@ all: $(BUILD)/lens2pov
 deps:
 	@sh tools/deps.sh $(DEB_PACKAGES)
 
-$(BUILD)/obj/%.o: src/%.c $(wildcard src/*.h) | $(BUILD)/obj
-	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -c $< -o $@
+# -MMD -MP: each object also writes the headers it includes (a .d file beside it), so that a
+# changed header rebuilds exactly the objects that include it; a changed Makefile rebuilds all.
+$(BUILD)/obj/%.o: src/%.c Makefile | $(BUILD)/obj
+	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -MMD -MP -c $< -o $@
 
 # The only C++ (src/image_io.cpp) goes into the shared library only, hence -fPIC.
-$(BUILD)/obj/%.o: src/%.cpp $(wildcard src/*.h) | $(BUILD)/obj
-	$(CXX) $(CXXFLAGS_BASE) $(SAN) $(CXXFLAGS) -fPIC $(OIIO_CFLAGS) -c $< -o $@
+$(BUILD)/obj/%.o: src/%.cpp Makefile | $(BUILD)/obj
+	$(CXX) $(CXXFLAGS_BASE) $(SAN) $(CXXFLAGS) -fPIC $(OIIO_CFLAGS) -MMD -MP -c $< -o $@
 
-$(BUILD)/tobj/%.o: tests/%.c $(wildcard src/*.h tests/*.h) | $(BUILD)/tobj
-	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -Isrc -DLENS2POV_SOURCE_DIR='"$(CURDIR)"' -c $< -o $@
+$(BUILD)/tobj/%.o: tests/%.c Makefile | $(BUILD)/tobj
+	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -Isrc -DLENS2POV_SOURCE_DIR='"$(CURDIR)"' -MMD -MP -c $< -o $@
 
 $(BUILD)/liblens2pov.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
@@ -66,6 +71,8 @@ $(BUILD)/run_tests: $(TEST_OBJ) $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
 $(BUILD)/obj $(BUILD)/tobj:
 	mkdir -p $@
 
+-include $(wildcard $(BUILD)/obj/*.d $(BUILD)/tobj/*.d)
+
 # The test suite runs the built binary too, so it needs both.
 test-unit: $(BUILD)/lens2pov $(BUILD)/run_tests
 	LENS2POV=$(CURDIR)/$(BUILD)/lens2pov $(BUILD)/run_tests $(TEST_ARGS)
@@ -82,7 +89,7 @@ test-extra: fuzz valgrind
 # The same suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its own build folder.
 test-sanitize: deps
 	$(MAKE) BUILD=build-san OPT=-O1 \
-	  SAN='-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer' \
+	  SAN='$(SANITIZERS)' \
 	  TEST_ARGS='$(TEST_ARGS) --jobs 2' test-unit
 
 bench: deps $(BUILD)/lens2pov $(BUILD)/bench_trace
@@ -104,7 +111,7 @@ stability: deps $(BUILD)/lens2pov
 	sh tools/stability.sh $(BUILD)
 
 fuzz: deps
-	sh tests/fuzz/run.sh
+	FUZZ_CFLAGS='$(C_DIALECT) -g -O1' FUZZ_SANITIZERS='$(SANITIZERS)' sh tests/fuzz/run.sh
 
 valgrind: deps $(BUILD)/lens2pov
 	sh tools/valgrind.sh $(BUILD)/lens2pov

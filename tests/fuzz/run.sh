@@ -7,6 +7,7 @@
 #   FUZZ_SECONDS  seconds per target (default 20)
 #   FUZZ_BUILD    build folder (default build-fuzz, removed by make clean)
 #   FUZZ_CC       compiler (default clang; needs libclang-rt-14-dev for -fsanitize=fuzzer)
+#   FUZZ_CFLAGS, FUZZ_SANITIZERS   compiler and sanitizer flags: make fuzz passes the Makefile's
 #
 # New inputs the fuzzer finds go to FUZZ_BUILD/corpus-*, never into the committed seeds.
 # To replay one input: build-fuzz/fuzz_lens FILE (or fuzz_options FILE).
@@ -16,8 +17,9 @@ root=$(cd "$here/../.." && pwd)
 out=${FUZZ_BUILD:-$root/build-fuzz}
 cc=${FUZZ_CC:-clang}
 seconds=${FUZZ_SECONDS:-20}
-san='-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer'
-cflags="-std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -g -O1 -fno-math-errno -ffp-contract=off -I$root/src"
+# The language and sanitizer flags are the Makefile's: run this as make fuzz.
+san=${FUZZ_SANITIZERS:?"run it as make fuzz, which gives the flags"}
+cflags="${FUZZ_CFLAGS:?"run it as make fuzz, which gives the flags"} -I$root/src"
 
 mkdir -p "$out/obj"
 # Every C source but main.c, instrumented for coverage (fuzzer-no-link), into an archive: the
