@@ -1,6 +1,6 @@
 /* Triangles that carry rays to POV-Ray's mesh_camera, which shoots a face's ray from its
    centroid (P1 + P2 + P3) / 3 along normalize((P3 - P1) x (P2 - P1)) (see
-   ../shared/docs/povray-mesh-camera.md). POV-Ray stores vertices as float32, so a face is only
+   docs/povray.md). POV-Ray stores vertices as float32, so a face is only
    as good as the ratio of its vertices' distance from the mesh's origin to its own size. */
 #ifndef LENS2POV_POVFACE_H
 #define LENS2POV_POVFACE_H

@@ -1,6 +1,6 @@
 /* Writing the ray table for POV-Ray's mesh_camera: one triangle per ray, whose centroid is the
    ray's origin and whose normal, in POV-Ray's reversed winding, normalize((P3-P1) x (P2-P1)),
-   is its direction (see ../shared/docs/povray-mesh-camera.md). Also writes the settings
+   is its direction (see docs/povray.md). Also writes the settings
    (.ini), the sample map (.map) and, on request, the ray table as CSV.
 
    Layout for distribution 0 at one ray per pixel: faces fill rows of packed_width pixels.

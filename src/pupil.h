@@ -1,5 +1,5 @@
-/* Exit pupils (Kolb, Mitchell and Hanrahan 1995, section 3.3): the region of a plane on the
-   film side toward which film rays are aimed, and sampling it. */
+/* Exit pupils (Kolb, Mitchell and Hanrahan 1995): the region of a plane on the film side
+   toward which film rays are aimed, and sampling it. */
 #ifndef LENS2POV_PUPIL_H
 #define LENS2POV_PUPIL_H
 

@@ -1,5 +1,6 @@
-/* The thick lens of any run of surfaces (seed section II): cardinal points from two traced rays
-   parallel to the axis, the real <-> image space transforms, and thick-lens tracing.
+/* The thick lens of any run of surfaces, as Kolb, Mitchell and Hanrahan (1995) approximate a
+   lens: cardinal points from two traced rays parallel to the axis, the real <-> image space
+   transforms, and thick-lens tracing.
 
    "Real" space is the scene side of the subsystem, "image" space its film side. Points are
    camera-space z coordinates in mm. Newton's form of the imaging equation, with x measured

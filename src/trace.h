@@ -1,4 +1,5 @@
-/* Full simulation: a ray through the lens surfaces, in double precision (seed section IV). */
+/* Full simulation, as Kolb, Mitchell and Hanrahan (1995) trace a lens: a ray through the lens
+   surfaces, in double precision. */
 #ifndef LENS2POV_TRACE_H
 #define LENS2POV_TRACE_H
 
