@@ -1,5 +1,6 @@
 #include "camera.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "focus.h"
@@ -67,11 +68,15 @@ static int setup_aperture(lens *l, const camera_options *o, double efl_mm, l2p_e
         if (st)
             return st;
         const double magnification = 2.0 * r / l->stop_diameter_mm;
-        diameter = efl_mm / (o->f_number * magnification);
-        if (diameter > full * (1.0 + 1e-12))
+        /* The widest as the message prints it (4 digits) counts as the widest: a user who
+           types back f/2.03 for 2.03015 gets the full opening. */
+        char widest[32];
+        snprintf(widest, sizeof widest, "%.4g", efl_mm / (full * magnification));
+        if (o->f_number < strtod(widest, NULL))
             return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
-                            "--f-number %g is faster than the lens: its widest is f/%.4g",
-                            o->f_number, efl_mm / (full * magnification));
+                            "--f-number %g is faster than the lens: its widest is f/%s",
+                            o->f_number, widest);
+        diameter = fmin(full, efl_mm / (o->f_number * magnification));
     }
     if (!(diameter > 0.0) || diameter > full * (1.0 + 1e-12))
         return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[l->stop].line,

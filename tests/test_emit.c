@@ -279,3 +279,39 @@ Test(emit, shared_edges_survive_chunk_boundaries)
     cr_assert_eq((vertices - whole) % 2, 0);
     free(rows);
 }
+
+/* --f-number is compared at the precision the refusal prints the widest (4 digits): typing back
+   the printed f/2.03 for the double-Gauss's 2.0301... opens the stop fully; a hundredth faster
+   is refused, naming the widest as printed. The widest is taken from the camera at full
+   opening, independently of the refusal's arithmetic. */
+Test(emit, the_widest_f_number_as_printed_opens_the_stop_fully)
+{
+    camera full;
+    camera_for("dgauss.50mm", "stop-image", &full);
+    char printed[32];
+    snprintf(printed, sizeof printed, "%.4g", full.f_number);
+    const double stop_mm = full.lens.surface[full.lens.stop].aperture_mm;
+    cr_assert(strtod(printed, NULL) < full.f_number, "the printed widest %s rounds down %.9g",
+              printed, full.f_number);
+    camera_free(&full);
+    const double asked[] = {strtod(printed, NULL), strtod(printed, NULL) - 0.01};
+    for (int k = 0; k < 2; k++) {
+        lens l;
+        l2p_error err;
+        cr_assert_eq(lens_read(LENS_DIR "dgauss.50mm.dat", &l, &err), 0);
+        camera_options o;
+        camera_options_default(&o);
+        o.look_at = v3(0, 0, 3);
+        o.f_number = asked[k];
+        camera c;
+        const int st = camera_setup(&c, &l, &o, &err);
+        if (k == 0) {
+            cr_assert_eq(st, 0, "f/%g: %s", asked[k], err.text);
+            cr_assert_eq(c.lens.stop_diameter_mm, stop_mm, "f/%g opens the stop fully", asked[k]);
+        } else {
+            cr_assert_eq(st, L2P_BAD_INPUT, "f/%g", asked[k]);
+            cr_assert(strstr(err.text, printed) != NULL, "%s", err.text);
+        }
+        camera_free(&c);
+    }
+}
