@@ -22,10 +22,11 @@ OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenIm
 # OpenImageIO is not linked into the executables: src/image_io.cpp alone becomes
 # lens2pov-image-io.so beside them, which src/image_io_loader.c dlopen()s on the first image read
 # or write (`info` and `trace` never load it). The library calls back into the executable for
-# these three functions, so every executable that may load it exports them.
+# these four functions, so every executable that may load it exports them.
 IMAGE_IO_SO    = $(BUILD)/lens2pov-image-io.so
 IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbol=outfile_track \
-                 -Wl,--export-dynamic-symbol=outfile_untrack
+                 -Wl,--export-dynamic-symbol=outfile_untrack \
+                 -Wl,--export-dynamic-symbol=outfile_create_temp
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
                pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core

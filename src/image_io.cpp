@@ -8,11 +8,8 @@
 // piecewise curve with the linear toe), not with ImageBufAlgo::colorconvert: that one depends on
 // which OpenColorIO configuration is installed, and the tests pin exact 8-bit codes.
 
-// error.h and outfile.h are plain C headers without extern "C" guards of their own.
-extern "C" {
 #include "error.h"
 #include "outfile.h"
-}
 #include "image_io_impl.h"
 
 #include <OpenImageIO/imageio.h>
@@ -209,15 +206,24 @@ file_kind kind_of(const std::string &ext)
     return file_kind::UNKNOWN;
 }
 
-// "<dir>/.<base>.tmp<pid><ext>": beside the output (so rename is atomic), hidden, and keeping
-// the extension so that OpenImageIO picks the same writer.
-std::string temp_path_for(const std::string &path, const std::string &ext)
+// "<dir>/.<base>.tmp<random><ext>", created empty and exclusively by outfile_create_temp, for
+// OpenImageIO to write: beside the output (so rename is atomic), hidden, and keeping the
+// extension so that OpenImageIO picks the same writer.
+int make_temp(const std::string &path, const std::string &ext, std::string &temp, l2p_error *err)
 {
     const size_t slash = path.find_last_of('/');
     const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
     const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
     const std::string base = name.substr(0, name.size() - ext.size());
-    return dir + "." + base + ".tmp" + std::to_string((long)getpid()) + ext;
+    char *made = nullptr;
+    const int fd = outfile_create_temp((dir + "." + base + ".tmp").c_str(), ext.c_str(), &made);
+    if (fd < 0)
+        return fail(err, errno == ENOENT || errno == ENOTDIR ? L2P_BAD_INPUT : L2P_FAILED,
+                    path.c_str(), std::string("cannot write: ") + std::strerror(errno));
+    close(fd);
+    temp = made;
+    std::free(made);
+    return L2P_OK;
 }
 
 // A missing folder is the user's mistake (status 2), as in outfile_open.
@@ -334,7 +340,9 @@ int write_rgb(const char *path, int width, int height, const float *pixels,
         return st;
     ImageSpec spec = make_spec(kind, width, height);
     add_attributes(spec, attributes, attribute_count);
-    const std::string temp = temp_path_for(path, ext);
+    std::string temp;
+    if ((st = make_temp(path, ext, temp, err)))
+        return st;
     outfile_track(temp.c_str());
     try {
         st = write_temp(temp, path, kind, spec, pixels, err);

@@ -1,10 +1,14 @@
 #include "outfile.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/random.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 /* Temporary paths to remove if a signal ends the run. A fixed table, so that the signal handler
@@ -105,21 +109,67 @@ void outfile_install_signal_cleanup(void)
     sigaction(SIGHUP, &sa, NULL);
 }
 
+/* 48 random bits: getrandom's, or where it fails (an old kernel) the clock's and the process's
+   mixed, which no one else can predict to the nanosecond either. */
+static uint64_t random_bits(void)
+{
+    uint64_t r;
+    if (getrandom(&r, sizeof r, 0) != (ssize_t)sizeof r) {
+        struct timespec t;
+        clock_gettime(CLOCK_REALTIME, &t);
+        r = ((uint64_t)t.tv_sec * 1000000007u) ^ (uint64_t)t.tv_nsec ^ ((uint64_t)getpid() << 32);
+        r ^= r >> 29;
+        r *= 0xbf58476d1ce4e5b9ULL;
+        r ^= r >> 32;
+    }
+    return r & 0xffffffffffffULL;
+}
+
+int outfile_create_temp(const char *prefix, const char *suffix, char **path)
+{
+    const size_t n = strlen(prefix) + strlen(suffix) + 13;
+    char *p = malloc(n);
+    if (!p) {
+        errno = ENOMEM;
+        return -1;
+    }
+    for (int attempt = 0; attempt < 64; attempt++) {
+        snprintf(p, n, "%s%012llx%s", prefix, (unsigned long long)random_bits(), suffix);
+        const int fd = open(p, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (fd >= 0) {
+            *path = p;
+            return fd;
+        }
+        if (errno != EEXIST)
+            break;
+    }
+    const int e = errno;
+    free(p);
+    errno = e;
+    return -1;
+}
+
 int outfile_open(outfile *f, const char *path, l2p_error *err)
 {
     memset(f, 0, sizeof *f);
-    size_t n = strlen(path) + 32;
+    char *prefix = malloc(strlen(path) + 5);
     f->final_path = strdup(path);
-    f->temp_path = malloc(n);
-    if (!f->final_path || !f->temp_path) {
+    if (!f->final_path || !prefix) {
+        free(prefix);
         outfile_discard(f);
         return l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
     }
-    snprintf(f->temp_path, n, "%s.tmp%ld", path, (long)getpid());
-    outfile_track(f->temp_path);
-    f->fp = fopen(f->temp_path, "wbe");   /* not inherited by POV-Ray */
+    strcpy(prefix, path);
+    strcat(prefix, ".tmp");
+    const int fd = outfile_create_temp(prefix, "", &f->temp_path);
+    free(prefix);
+    if (fd >= 0)
+        outfile_track(f->temp_path);
+    f->fp = fd >= 0 ? fdopen(fd, "wb") : NULL;   /* close-on-exec: not inherited by POV-Ray */
     if (!f->fp) {
-        int e = errno;
+        const int e = errno;
+        if (fd >= 0 && !f->fp)
+            close(fd);
         outfile_discard(f);
         return l2p_fail(err, e == ENOENT || e == ENOTDIR ? L2P_BAD_INPUT : L2P_FAILED, path, 0,
                         "cannot write: %s", strerror(e));

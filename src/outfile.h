@@ -19,10 +19,16 @@ typedef struct outfile {
     char *temp_path;
 } outfile;
 
+/* Creates an empty file named prefix, 12 random hex digits, suffix: exclusively (O_EXCL),
+   never through a symbolic link (O_NOFOLLOW), with what the umask leaves of 0666, so that no
+   one can guess the name beforehand or plant a link there. Returns its descriptor
+   (close-on-exec) with its name in *path (malloc'd), or -1 with errno set. */
+int outfile_create_temp(const char *prefix, const char *suffix, char **path);
+
 /* Installs the signal handlers that remove registered temporary files. Call once from main. */
 void outfile_install_signal_cleanup(void);
 
-/* Opens a temporary file beside path for writing. */
+/* Opens a temporary file beside path for writing (outfile_create_temp, "PATH.tmp..."). */
 int outfile_open(outfile *f, const char *path, l2p_error *err);
 
 /* Flushes and closes the temporary file (checking for write errors) without renaming it. */

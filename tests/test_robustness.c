@@ -5,8 +5,8 @@
      output;
    - killing lens2pov in the middle of writing leaves the previous outputs intact: SIGINT and
      SIGTERM also leave no temporary file behind; SIGKILL cannot be caught, so its temporary
-     files (PREFIX.inc.tmpPID, ...) stay, but the outputs themselves are never touched, because
-     they only ever appear by rename(2).
+     files (PREFIX.inc.tmp followed by 12 random hex digits, ...) stay, but the outputs
+     themselves are never touched, because they only ever appear by rename(2).
    The fuzz targets (tests/fuzz/) and valgrind (tools/valgrind.sh) cover the rest. */
 #include <criterion/criterion.h>
 #include <dirent.h>
@@ -21,6 +21,7 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
+#include "outfile.h"
 #include "support.h"
 
 extern char **environ;
@@ -531,4 +532,49 @@ Test(robustness, sigint_during_render_keeps_the_previous_image_and_cleans_up)
     const char *first;
     cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "left %s", first);
     remove_tree(dir);
+}
+
+/* Temporary files are created exclusively under unpredictable names: symbolic links planted at
+   the names the previous code used (OUT.EXT.tmpPID, for the next few hundred process ids) are
+   never written through, and two temporary files of one prefix get different names, each a
+   new file of its own. */
+Test(robustness, planted_links_never_receive_a_temporary_file)
+{
+    const char *dir = test_tmpdir();
+    char *victim = strdup(tmp_path(dir, "victim"));   /* tmp_path's buffers rotate */
+    write_text(victim, "keep me\n");
+    const char *exts[] = {"inc", "ini", "map", "csv"};
+    const pid_t next = getpid();
+    for (int e = 0; e < 4; e++)
+        for (int k = 0; k < 300; k++) {
+            char name[64];
+            snprintf(name, sizeof name, "out.%s.tmp%ld", exts[e], (long)next + k);
+            cr_assert_eq(symlink(victim, tmp_path(dir, name)), 0);
+        }
+    char *errtext;
+    const int st = run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "8", "--height", "6",
+                                "--spp", "2", "-o", tmp_path(dir, "out"), "--rays",
+                                tmp_path(dir, "out.csv"), "--quiet", NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    free(errtext);
+    size_t n;
+    char *kept = read_text(victim, &n);
+    cr_assert_str_eq(kept, "keep me\n", "a planted link was written through");
+    free(kept);
+    free(victim);
+    struct stat sb;
+    cr_assert_eq(lstat(tmp_path(dir, "out.ini"), &sb), 0);
+    cr_assert(S_ISREG(sb.st_mode), "out.ini is a file of its own, not a link");
+
+    char *a = NULL, *b = NULL;
+    const char *prefix = tmp_path(dir, "t.tmp");
+    const int fa = outfile_create_temp(prefix, ".x", &a), fb = outfile_create_temp(prefix, ".x", &b);
+    cr_assert(fa >= 0 && fb >= 0);
+    cr_assert_str_neq(a, b);
+    cr_assert_eq(strncmp(a, prefix, strlen(prefix)), 0);
+    cr_assert_eq(strlen(a), strlen(prefix) + 12 + 2, "%s", a);
+    close(fa);
+    close(fb);
+    free(a);
+    free(b);
 }
