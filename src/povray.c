@@ -12,6 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -347,11 +348,17 @@ static void write_text(int fd, const char *a, const char *b)
         return;
 }
 
-/* In the child: default signal handling (ours would remove the run's files), stdin from
+/* In the child: default signal handling (ours would remove the run's files), SIGTERM when
+   lens2pov dies however it dies (SIGKILL, the out-of-memory killer: the parent-death signal
+   outlives execv; lens2pov forks from its main thread, whose end is the process's), stdin from
    /dev/null, stdout and stderr into the log, the scene's folder as working folder. Only
    async-signal-safe calls: the parent may have threads. */
-static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *old_mask)
+static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *old_mask,
+                       pid_t parent)
 {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent)   /* the parent died before prctl: nothing would stop us */
+        _exit(127);
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
     signal(SIGHUP, SIG_DFL);
@@ -376,9 +383,9 @@ static pid_t spawn(const run *r, char **argv, int log_fd)
 {
     sigset_t old;
     outfile_block_signals(&old);
-    const pid_t pid = fork();
+    const pid_t parent = getpid(), pid = fork();
     if (pid == 0)
-        exec_child(r, argv, log_fd, &old);
+        exec_child(r, argv, log_fd, &old, parent);
     if (pid > 0)
         outfile_track_child(pid);
     pthread_sigmask(SIG_SETMASK, &old, NULL);

@@ -63,6 +63,32 @@ typedef struct workspace {
     bool keep;
 } workspace;
 
+static void remove_workspace(const workspace *w);
+
+/* Workspaces are named lens2pov.PID.XXXXXX. One whose process is gone (killed with SIGKILL,
+   which no handler sees) is removed by the next render that looks in the same folder, when it
+   is ours: so they never pile up. A process id taken again by another process keeps its
+   folder until that one ends too. */
+static void remove_stale_workspaces(const char *tmp)
+{
+    DIR *d = opendir(tmp);
+    if (!d)
+        return;
+    for (struct dirent *e; (e = readdir(d)) != NULL;) {
+        long pid;
+        char rest[16];
+        if (sscanf(e->d_name, "lens2pov.%ld.%15s", &pid, rest) != 2 || strlen(rest) != 6 ||
+            pid <= 0 || (kill((pid_t)pid, 0) == 0 || errno != ESRCH))
+            continue;
+        workspace stale = {.keep = false};
+        struct stat sb;
+        snprintf(stale.dir, sizeof stale.dir, "%s/%s", tmp, e->d_name);
+        if (lstat(stale.dir, &sb) == 0 && S_ISDIR(sb.st_mode) && sb.st_uid == getuid())
+            remove_workspace(&stale);
+    }
+    closedir(d);
+}
+
 static int make_workspace(workspace *w, const cli *c, l2p_error *err)
 {
     w->keep = c->keep_temp != NULL;
@@ -73,7 +99,9 @@ static int make_workspace(workspace *w, const cli *c, l2p_error *err)
         return L2P_OK;
     }
     const char *tmp = getenv("TMPDIR");
-    snprintf(w->dir, sizeof w->dir, "%s/lens2pov.XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    tmp = tmp && *tmp ? tmp : "/tmp";
+    remove_stale_workspaces(tmp);
+    snprintf(w->dir, sizeof w->dir, "%s/lens2pov.%ld.XXXXXX", tmp, (long)getpid());
     if (!mkdtemp(w->dir))
         return l2p_fail(err, L2P_FAILED, w->dir, 0, "cannot make a temporary folder: %s",
                         strerror(errno));

@@ -578,3 +578,74 @@ Test(robustness, planted_links_never_receive_a_temporary_file)
     free(a);
     free(b);
 }
+
+/* Whether process pid is gone: no such process, or a zombie waiting for a reaper. */
+static bool process_gone(long pid)
+{
+    if (kill((pid_t)pid, 0) != 0 && errno == ESRCH)
+        return true;
+    char path[64], state = '?';
+    snprintf(path, sizeof path, "/proc/%ld/stat", pid);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return true;
+    const int got = fscanf(f, "%*d (%*[^)]) %c", &state);
+    fclose(f);
+    return got == 1 && (state == 'Z' || state == 'X');
+}
+
+/* render killed outright (SIGKILL: no handler runs) stops its POV-Ray processes all the same
+   (they get the parent-death signal), and the next render removes the workspace it left. The
+   stand-in for POV-Ray writes its pid and sleeps for a minute. */
+Test(robustness, render_killed_outright_leaves_no_povray_and_its_workspace_goes_next_time)
+{
+    const char *dir = test_tmpdir();
+    char *scene = strdup(tmp_path(dir, "scene.pov")), *pids = strdup(tmp_path(dir, "pids"));
+    char *fake = strdup(tmp_path(dir, "fakepov")), *image = strdup(tmp_path(dir, "img.png"));
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb 1 }\n");
+    char script[1200];
+    snprintf(script, sizeof script, "#!/bin/sh\necho $$ >> '%s'\nexec sleep 60\n", pids);
+    write_text(fake, script);
+    cr_assert_eq(chmod(fake, 0755), 0);
+    cr_assert_eq(setenv("LENS2POV_POVRAY", fake, 1), 0);
+    char *argv[] = {"render", scene, DGAUSS, "--width", "64", "--height", "48", "--spp", "4",
+                    "--jobs", "2", "--memory-mb", "0.15", "-o", image, "--quiet", NULL};
+    const pid_t pid = spawn_lens2pov(argv, dir);
+    long started[2] = {0, 0};
+    int n = 0;
+    for (int waited = 0; waited < 20000 && n < 2; waited += 20) {
+        sleep_ms(20);
+        FILE *f = fopen(pids, "r");
+        for (n = 0; f && n < 2 && fscanf(f, "%ld", &started[n]) == 1;)
+            n++;
+        if (f)
+            fclose(f);
+    }
+    cr_assert_eq(n, 2, "the two POV-Ray stand-ins never started");
+    cr_assert_eq(kill(pid, SIGKILL), 0);
+    cr_assert_eq(waitpid(pid, NULL, 0), pid);
+    for (int k = 0; k < 2; k++) {
+        int waited = 0;
+        while (waited < 5000 && !process_gone(started[k])) {
+            sleep_ms(20);
+            waited += 20;
+        }
+        cr_expect(process_gone(started[k]), "POV-Ray stand-in %ld outlived lens2pov", started[k]);
+    }
+    char left[64];
+    snprintf(left, sizeof left, "lens2pov.%ld.", (long)pid);
+    cr_assert(has_file(dir, left, 0), "the killed render left no workspace to clean");
+    /* The next render, with the real POV-Ray, sweeps it away. */
+    cr_assert_eq(unsetenv("LENS2POV_POVRAY"), 0);
+    char *again[] = {"render", scene, DGAUSS, "--width", "8", "--height", "6", "--spp", "1",
+                     "-o", image, "--quiet", NULL};
+    const pid_t next = spawn_lens2pov(again, dir);
+    int status = 0;
+    cr_assert_eq(waitpid(next, &status, 0), next);
+    cr_assert(WIFEXITED(status) && WEXITSTATUS(status) == 0, "status %#x", status);
+    cr_expect_not(has_file(dir, left, 0), "the killed render's workspace is still there");
+    free(scene);
+    free(pids);
+    free(fake);
+    free(image);
+}
