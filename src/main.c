@@ -77,11 +77,26 @@ static int cmd_info(const cli *c, l2p_error *err)
     return st;
 }
 
+/* trace's outputs, checked before any work: PREFIX.inc stands for the set beside it. */
+static int check_trace_outputs(const cli *c, l2p_error *err)
+{
+    char *inc = malloc(strlen(c->output) + 5);
+    if (!inc)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    sprintf(inc, "%s.inc", c->output);
+    int st = outfile_check_path(inc, err);
+    free(inc);
+    if (!st && c->rays_csv)
+        st = outfile_check_path(c->rays_csv, err);
+    return st;
+}
+
 static int cmd_trace(const cli *c, l2p_error *err)
 {
     camera cam;
     int st = need(c, 1, true, err);
-    if (st || (st = load_camera(c, c->positional[0], &cam, err)))
+    if (st || (st = check_trace_outputs(c, err)) ||
+        (st = load_camera(c, c->positional[0], &cam, err)))
         return st;
     cli_warn(c);
     raytable_stats stats;
@@ -127,12 +142,15 @@ static int cmd_develop(const cli *c, l2p_error *err)
 {
     if (c->positional_count < 1 || !c->output)
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "develop takes PREFIX [RENDER.exr ...] -o IMAGE");
+    int st = outfile_check_path(c->output, err);
+    if (st)
+        return st;
     char *map_path = malloc(strlen(c->positional[0]) + 8);
     if (!map_path)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     sprintf(map_path, "%s.map", c->positional[0]);
     samplemap map;
-    int st = samplemap_read(map_path, &map, err);
+    st = samplemap_read(map_path, &map, err);
     free(map_path);
     if (st)
         return st;

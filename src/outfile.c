@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/random.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -147,6 +148,25 @@ int outfile_create_temp(const char *prefix, const char *suffix, char **path)
     free(p);
     errno = e;
     return -1;
+}
+
+int outfile_check_path(const char *path, l2p_error *err)
+{
+    struct stat sb;
+    if (!*path)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "an output file name is empty");
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return l2p_fail(err, L2P_BAD_INPUT, path, 0, "cannot write: Is a directory");
+    const char *slash = strrchr(path, '/');
+    char *dir = slash ? strndup(path, (size_t)(slash - path) + 1) : strdup(".");
+    if (!dir)
+        return l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
+    const char *why = stat(dir, &sb) != 0    ? strerror(errno)
+                      : !S_ISDIR(sb.st_mode) ? strerror(ENOTDIR)
+                      : access(dir, W_OK | X_OK) != 0 ? strerror(errno)
+                                                       : NULL;
+    free(dir);
+    return why ? l2p_fail(err, L2P_BAD_INPUT, path, 0, "cannot write: %s", why) : L2P_OK;
 }
 
 int outfile_open(outfile *f, const char *path, l2p_error *err)

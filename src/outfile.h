@@ -25,6 +25,10 @@ typedef struct outfile {
    (close-on-exec) with its name in *path (malloc'd), or -1 with errno set. */
 int outfile_create_temp(const char *prefix, const char *suffix, char **path);
 
+/* Checks, before any work, that path can become an output: its folder exists and may be
+   written, and path is not a folder. L2P_BAD_INPUT with a message naming path otherwise. */
+int outfile_check_path(const char *path, l2p_error *err);
+
 /* Installs the signal handlers that remove registered temporary files. Call once from main. */
 void outfile_install_signal_cleanup(void);
 

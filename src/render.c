@@ -31,7 +31,11 @@ static int check_inputs(const cli *c, l2p_error *err)
     if (!f)
         return l2p_fail(err, L2P_BAD_INPUT, c->positional[0], 0, "cannot read: %s", strerror(errno));
     fclose(f);
-    return L2P_OK;
+    /* Before any work: a render of minutes must not fail at its last step. */
+    int st = outfile_check_path(c->output, err);
+    if (!st && c->rays_csv)
+        st = outfile_check_path(c->rays_csv, err);
+    return st;
 }
 
 static int number_of_cores(void)

@@ -649,3 +649,54 @@ Test(robustness, render_killed_outright_leaves_no_povray_and_its_workspace_goes_
     free(fake);
     free(image);
 }
+
+/* Every output is checked before any work: a missing folder, a folder where a file is
+   expected. Exit 2 with a message naming the path, in well under a second (the render asked
+   for would take many), and nothing written. */
+Test(robustness, bad_output_paths_are_refused_before_any_work)
+{
+    const char *dir = test_tmpdir();
+    char *scene = strdup(tmp_path(dir, "scene.pov")), *sub = strdup(tmp_path(dir, "sub"));
+    char *missing = strdup(tmp_path(dir, "missing/x")), *missing_png = strdup(tmp_path(dir, "missing/x.png"));
+    char *out = strdup(tmp_path(dir, "out")), *png = strdup(tmp_path(dir, "out.png"));
+    write_text(scene, "background { rgb 1 }\n");
+    cr_assert_eq(mkdir(sub, 0755), 0);
+    cr_assert_eq(mkdir(tmp_path(dir, "dir.png"), 0755), 0);
+    char *dir_png = strdup(tmp_path(dir, "dir.png"));
+    struct {
+        const char *args[16];
+        const char *named;
+    } cases[] = {
+        {{"trace", DGAUSS, "-o", missing}, missing},
+        {{"trace", DGAUSS, "-o", out, "--rays", sub}, sub},
+        {{"trace", DGAUSS, "-o", out, "--rays", missing}, missing},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", missing_png}, missing_png},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", dir_png}, dir_png},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--rays", sub}, sub},
+        {{"develop", out, "-o", missing_png}, missing_png},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *const *a = cases[i].args;
+        char *errtext = NULL;
+        struct timespec t0, t1;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        const int st = run_lens2pov(NULL, &errtext, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
+                                    a[8], a[9], a[10], a[11], a[12], a[13], NULL);
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        const double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        cr_expect_eq(st, 2, "case %zu: exit %d: %s", i, st, errtext);
+        cr_expect(errtext && strstr(errtext, cases[i].named), "case %zu: %s", i, errtext);
+        cr_expect_lt(seconds, 1.0, "case %zu took %.2f s", i, seconds);
+        free(errtext);
+        const char *const allowed[] = {"scene.pov", "sub", "dir.png", NULL};
+        const char *first;
+        cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "case %zu wrote %s", i, first);
+    }
+    free(scene);
+    free(sub);
+    free(missing);
+    free(missing_png);
+    free(out);
+    free(png);
+    free(dir_png);
+}
