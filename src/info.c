@@ -37,14 +37,25 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
     return st;
 }
 
-/* Half field angle, degrees: the chief ray from film point p, aimed at the centre of the exit
-   pupil, traced out of the lens; NAN when the lens blocks it. */
+/* Half field angle, degrees: the ray from film point p through the middle of the pupil region
+   sampled for it, traced out of the lens. Where the lens passes nothing from p (beyond a
+   fisheye's image circle) the field ends at the image circle: the film point is moved toward
+   the centre, by bisection, to the last place its ray passes. NAN when even the centre's is
+   blocked. */
 static double half_field_deg(const camera *c, vec3 p)
 {
     ray r;
-    double w;
-    if (!camera_trace(c, p, 0.5, 0.5, &r, &w))
-        return NAN;
+    double w, in = 1.0, out = 1.0;
+    if (!camera_trace(c, p, 0.5, 0.5, &r, &w)) {
+        if (!camera_trace(c, v3(0, 0, 0), 0.5, 0.5, &r, &w))
+            return NAN;
+        in = 0.0;
+        for (int k = 0; k < 60; k++) {
+            const double mid = 0.5 * (in + out);
+            *(camera_trace(c, v3_scale(p, mid), 0.5, 0.5, &r, &w) ? &in : &out) = mid;
+        }
+        camera_trace(c, v3_scale(p, in), 0.5, 0.5, &r, &w);
+    }
     return acos(fmin(1.0, r.d.z)) * 180.0 / M_PI;
 }
 
@@ -90,9 +101,14 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, 
             {"hfov_deg", "horizontal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0, 0))},
             {"vfov_deg", "vertical field of view", "deg", 2 * half_field_deg(c, v3(0, 0.5 * fi->height_mm, 0))},
             {"dfov_deg", "diagonal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0.5 * fi->height_mm, 0))},
+            /* Only where the lens passes nothing beyond it (a fisheye's image circle). */
+            {"image_circle_mm", "image circle diameter", "mm",
+             isfinite(c->pupil.reach_mm) ? 2.0 * c->pupil.reach_mm : NAN},
         };
         memcpy(f + n, more, sizeof more);
         n += (int)(sizeof more / sizeof more[0]);
+        if (!json && !isfinite(f[n - 1].value))
+            n--;   /* no image circle: the lens covers the film (JSON says null) */
     }
     if (json) {
         fputs("{\n  \"lens\": \"", out);

@@ -421,3 +421,32 @@ Test(pupil, the_reach_is_where_the_image_circle_ends)
         camera_free(&c);
     }
 }
+
+/* info on a film larger than the fisheye's image circle: the field of view is the circle's,
+   the same horizontally and diagonally, never "nan", and the circle's diameter is printed. */
+Test(pupil, info_gives_the_fisheyes_field_at_its_image_circle)
+{
+    char *out = NULL, *errtext = NULL;
+    int st = run_lens2pov(&out, &errtext, "info", LENS_DIR "fisheye.10mm.dat", "--width", "320",
+                          "--height", "240", "--json", NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    double h = NAN, d = NAN, circle = NAN;
+    const char *at = strstr(out, "\"hfov_deg\":");
+    if (at)
+        sscanf(at, "\"hfov_deg\": %lf", &h);
+    if ((at = strstr(out, "\"dfov_deg\":")))
+        sscanf(at, "\"dfov_deg\": %lf", &d);
+    if ((at = strstr(out, "\"image_circle_mm\":")))
+        sscanf(at, "\"image_circle_mm\": %lf", &circle);
+    cr_assert(h > 140 && h < 180, "hfov %g\n%s", h, out);
+    cr_assert_float_eq(d, h, 1e-6, "dfov %g, hfov %g", d, h);
+    cr_assert(circle > 20 && circle < 35, "image circle %g mm", circle);
+    free(out);
+    free(errtext);
+    st = run_lens2pov(&out, &errtext, "info", LENS_DIR "fisheye.10mm.dat", "--width", "320",
+                      "--height", "240", NULL);
+    cr_assert_eq(st, 0);
+    cr_assert_null(strstr(out, "nan"), "%s", out);
+    free(out);
+    free(errtext);
+}
