@@ -1,6 +1,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -327,8 +328,14 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
     return check_contradictions(c, err);
 }
 
-void cli_warn(const cli *c)
+void cli_warn(const cli *c, const camera *cam)
 {
+    /* A film nearer the lens than its focal plane images a virtual object: nothing in front of
+       the lens is sharp. */
+    if (!isnan(c->cam.film_distance_mm) && !(cam->focus_distance_units > 0.0))
+        fprintf(stderr, "lens2pov: warning: --film-distance %g mm focuses %g units behind the "
+                        "film: nothing in the scene is sharp\n", c->cam.film_distance_mm,
+                -cam->focus_distance_units);
     if (c->cam.pupil == PUPIL_STOP && c->cam.trace == TRACE_KIND_FULL)
         fprintf(stderr, "lens2pov: warning: --pupil stop aims at the stop's own disk, which misses "
                         "rays the lens passes: the picture comes out too dark (a diagnostic; "

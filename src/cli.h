@@ -26,7 +26,8 @@ typedef struct cli {
 /* Parses argv[first..argc-1]. */
 int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
 
-/* Warns on stderr about options that give a wrong picture on purpose (--pupil stop). */
-void cli_warn(const cli *c);
+/* Warns on stderr about choices that give a picture the user may not expect: --pupil stop
+   (biased on purpose), a film distance that puts the focus behind the camera. */
+void cli_warn(const cli *c, const camera *cam);
 
 #endif

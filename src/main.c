@@ -69,6 +69,8 @@ static int cmd_info(const cli *c, l2p_error *err)
         if (st)
             camera_free(&cam);
     }
+    if (!st && with_camera)
+        cli_warn(c, &cam);
     if (!st)
         info_print(stdout, &l, &li, with_camera ? &cam : NULL, c->json);
     if (with_camera && !st)
@@ -98,7 +100,7 @@ static int cmd_trace(const cli *c, l2p_error *err)
     if (st || (st = check_trace_outputs(c, err)) ||
         (st = load_camera(c, c->positional[0], &cam, err)))
         return st;
-    cli_warn(c);
+    cli_warn(c, &cam);
     raytable_stats stats;
     /* One include unless --memory-mb asks for chunks that fit a POV-Ray process each. */
     const long long chunk_faces = c->memory_mb > 0 ? raytable_faces_for_memory(c->memory_mb) : 0;

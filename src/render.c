@@ -323,7 +323,6 @@ int render_command(const cli *c, l2p_error *err)
     int st = check_inputs(c, err);
     if (st)
         return st;
-    cli_warn(c);
     lens l;
     if ((st = lens_read(c->positional[1], &l, err)))
         return st;
@@ -332,6 +331,7 @@ int render_command(const cli *c, l2p_error *err)
         camera_free(&cam);
         return st;
     }
+    cli_warn(c, &cam);
     pthread_t loader;
     if (start_thread(&loader, load_image_library, NULL) == 0)
         pthread_detach(loader);   /* image_io_ready waits for it */

@@ -315,3 +315,30 @@ Test(emit, the_widest_f_number_as_printed_opens_the_stop_fully)
         camera_free(&c);
     }
 }
+
+/* A film distance shorter than the rear focal distance images a virtual object behind the film:
+   trace warns that nothing is sharp, and says nothing for a film beyond the focal plane. The
+   focal plane from info (back focal distance), not from the warning's arithmetic. */
+Test(emit, a_film_distance_that_focuses_behind_the_film_is_warned_about)
+{
+    char *out = NULL, *errtext = NULL;
+    cr_assert_eq(run_lens2pov(&out, &errtext, "info", LENS_DIR "dgauss.50mm.dat", "--json", NULL), 0);
+    double bfd = NAN;
+    const char *at = strstr(out, "\"bfd_mm\":");
+    cr_assert(at && sscanf(at, "\"bfd_mm\": %lf", &bfd) == 1, "%s", out);
+    free(out);
+    free(errtext);
+    const char *dir = test_tmpdir();
+    const double distances[] = {0.5 * bfd, 1.05 * bfd};
+    for (int k = 0; k < 2; k++) {
+        char d[32];
+        snprintf(d, sizeof d, "%.6f", distances[k]);
+        const int st = run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--width",
+                                    "4", "--height", "3", "--spp", "1", "--film-distance", d,
+                                    "-o", tmp_path(dir, "f"), "--quiet", NULL);
+        cr_assert_eq(st, 0, "%s", errtext);
+        const bool warned = strstr(errtext, "warning: --film-distance") != NULL;
+        cr_assert_eq(warned, k == 0, "film distance %s mm (bfd %g): %s", d, bfd, errtext);
+        free(errtext);
+    }
+}
