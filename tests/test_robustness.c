@@ -700,3 +700,35 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
     free(png);
     free(dir_png);
 }
+
+/* Every command answers --help with exit 0 on stdout, naming each option it takes and its
+   default, whatever else is on the line; --version names the program. */
+Test(robustness, every_command_has_help_and_there_is_a_version)
+{
+    const struct {
+        const char *command;
+        const char *options[12];
+    } cases[] = {
+        {"info", {"--json", "--width", "--spp", "--pupil", "--seed", "[640 x 480]", "[16]"}},
+        {"trace", {"--output", "--rays", "--memory-mb", "--quiet", "--crop", "--unit-mm", "[1000]"}},
+        {"develop", {"--output"}},
+        {"render", {"--output", "--jobs", "--memory-mb", "--rays", "--keep-temp", "--quiet",
+                    "--f-number", "[1024]", "[stop-image"}},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char *out = NULL, *errtext = NULL;
+        const int st = run_lens2pov(&out, &errtext, cases[i].command, "--width", "7", "--help", NULL);
+        cr_assert_eq(st, 0, "%s --help: exit %d: %s", cases[i].command, st, errtext);
+        cr_assert(strstr(out, "usage: lens2pov ") && strstr(out, cases[i].command), "%s", out);
+        for (int k = 0; cases[i].options[k]; k++)
+            cr_expect(strstr(out, cases[i].options[k]), "%s --help lacks %s", cases[i].command,
+                      cases[i].options[k]);
+        free(out);
+        free(errtext);
+    }
+    char *out = NULL, *errtext = NULL;
+    cr_assert_eq(run_lens2pov(&out, &errtext, "--version", NULL), 0);
+    cr_assert_eq(strncmp(out, "lens2pov ", 9), 0, "%s", out);
+    free(out);
+    free(errtext);
+}
