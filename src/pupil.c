@@ -89,8 +89,6 @@ static inline void disk_point(double u, double v, double *x, double *y)
     *y = r * sin(phi);
 }
 
-void concentric_disk(double u, double v, double *x, double *y) { disk_point(u, v, x, y); }
-
 vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 {
     /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */

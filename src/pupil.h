@@ -56,10 +56,6 @@ int pupil_stop_image(const lens *l, bool toward_film, double *z_mm, double *radi
    point samples the model's disk. */
 int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err);
 
-/* Shirley and Chiu's concentric map of the unit square onto the unit disk: it keeps strata
-   compact and areas proportional. */
-void concentric_disk(double u, double v, double *x, double *y);
-
 /* Fits the sampled region to the rays the lens passes (full simulation), for every film
    radius up to film_radius_mm. For each node the passing region of the pupil plane is found
    by bisecting its boundary in many directions; stop-image then samples the star-shaped
