@@ -11,16 +11,16 @@ OPT      ?= -O2
 # vector lanes and the one-ray kernel agree bit for bit only without it (GCC's gnu11 mode and
 # clang contract by default).
 C_DIALECT     = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -fno-math-errno -ffp-contract=off
-CFLAGS_BASE   = $(C_DIALECT) $(OPT) -g -Wall -Wextra -Werror
+CFLAGS_BASE   = $(C_DIALECT) $(OPT) -g -Wall -Wextra -Werror -Isrc
 # The sanitizers of make test-sanitize and of the fuzz targets.
 SANITIZERS    = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
-CXXFLAGS_BASE = -std=c++17 $(OPT) -g -Wall -Wextra -Werror
+CXXFLAGS_BASE = -std=c++17 $(OPT) -g -Wall -Wextra -Werror -Isrc
 SAN      ?=
 LDLIBS   = -lm -lpthread -ldl
 OIIO_CFLAGS = $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util)
-# OpenImageIO is not linked into the executables: src/image_io.cpp alone becomes
-# lens2pov-image-io.so beside them, which src/image_io_loader.c dlopen()s on the first image read
+# OpenImageIO is not linked into the executables: src/image/image_io.cpp alone becomes
+# lens2pov-image-io.so beside them, which src/image/image_io_loader.c dlopen()s on the first image read
 # or write (`info` and `trace` never load it). The library calls back into the executable for
 # these four functions, so every executable that may load it exports them.
 IMAGE_IO_SO    = $(BUILD)/lens2pov-image-io.so
@@ -31,7 +31,8 @@ IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbo
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
                pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core
 
-LIB_C   = $(filter-out src/main.c,$(wildcard src/*.c))
+# The sources, one folder per stage of the data flow (docs/source.md).
+LIB_C   = $(filter-out src/cli/main.c,$(wildcard src/*/*.c))
 LIB_OBJ = $(LIB_C:src/%.c=$(BUILD)/obj/%.o)
 TEST_C  = $(wildcard tests/*.c)
 TEST_OBJ = $(TEST_C:tests/%.c=$(BUILD)/tobj/%.o)
@@ -46,33 +47,35 @@ deps:
 
 # -MMD -MP: each object also writes the headers it includes (a .d file beside it), so that a
 # changed header rebuilds exactly the objects that include it; a changed Makefile rebuilds all.
-$(BUILD)/obj/%.o: src/%.c Makefile | $(BUILD)/obj
+$(BUILD)/obj/%.o: src/%.c Makefile
+	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -MMD -MP -c $< -o $@
 
-# The only C++ (src/image_io.cpp) goes into the shared library only, hence -fPIC.
-$(BUILD)/obj/%.o: src/%.cpp Makefile | $(BUILD)/obj
+# The only C++ (src/image/image_io.cpp) goes into the shared library only, hence -fPIC.
+$(BUILD)/obj/%.o: src/%.cpp Makefile
+	@mkdir -p $(@D)
 	$(CXX) $(CXXFLAGS_BASE) $(SAN) $(CXXFLAGS) -fPIC $(OIIO_CFLAGS) -MMD -MP -c $< -o $@
 
 $(BUILD)/tobj/%.o: tests/%.c Makefile | $(BUILD)/tobj
-	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -Isrc -DLENS2POV_SOURCE_DIR='"$(CURDIR)"' -MMD -MP -c $< -o $@
+	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -DLENS2POV_SOURCE_DIR='"$(CURDIR)"' -MMD -MP -c $< -o $@
 
 $(BUILD)/liblens2pov.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
-$(IMAGE_IO_SO): $(BUILD)/obj/image_io.o
+$(IMAGE_IO_SO): $(BUILD)/obj/image/image_io.o
 	$(CXX) $(SAN) -shared $^ -o $@ $(OIIO_LIBS)
 
 # Order-only: the library is loaded at run time, a new one needs no relink.
-$(BUILD)/lens2pov: $(BUILD)/obj/main.o $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
+$(BUILD)/lens2pov: $(BUILD)/obj/cli/main.o $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
 	$(CC) $(SAN) $(IMAGE_IO_HOST) $^ -o $@ $(LDLIBS)
 
 $(BUILD)/run_tests: $(TEST_OBJ) $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
 	$(CC) $(SAN) $(IMAGE_IO_HOST) $^ -o $@ -lcriterion $(LDLIBS)
 
-$(BUILD)/obj $(BUILD)/tobj:
+$(BUILD)/tobj:
 	mkdir -p $@
 
--include $(wildcard $(BUILD)/obj/*.d $(BUILD)/tobj/*.d)
+-include $(wildcard $(BUILD)/obj/*/*.d $(BUILD)/tobj/*.d)
 
 # The test suite runs the built binary too, so it needs both.
 test-unit: $(BUILD)/lens2pov $(BUILD)/run_tests
@@ -97,7 +100,7 @@ bench: deps $(BUILD)/lens2pov $(BUILD)/bench_trace
 	sh tools/bench.sh $(BUILD)
 
 $(BUILD)/bench_trace: tools/bench_trace.c $(BUILD)/liblens2pov.a
-	$(CC) $(CFLAGS_BASE) -Isrc $^ -o $@ $(LDLIBS)
+	$(CC) $(CFLAGS_BASE) $^ -o $@ $(LDLIBS)
 
 demo: deps $(BUILD)/lens2pov
 	sh tools/demo.sh $(BUILD)/lens2pov

@@ -8,7 +8,7 @@
 #define KVEC ld_vec
 #define KRAY ld_ray
 #define KNAME(f) ld_##f
-#include "trace_kernel.h"
+#include "optics/trace_kernel.h"
 
 trace_status precision_trace_range(const lens *l, int first, int last, bool toward_scene,
                                    ld_ray *r, int *blocked_at)

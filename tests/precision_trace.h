@@ -1,4 +1,4 @@
-/* A precision reference for the full simulation: src/trace_kernel.h built a second time with
+/* A precision reference for the full simulation: src/optics/trace_kernel.h built a second time with
    long double (x87 extended: a 64-bit significand, 11 more bits than double), over the same
    lens description. The double tracer and this one run the same formulas in the same order on
    the same inputs (the lens's numbers are doubles, exact in both), so the difference of their
@@ -7,8 +7,8 @@
 #define LENS2POV_PRECISION_TRACE_H
 
 #include <stdbool.h>
-#include "lens.h"
-#include "trace.h"
+#include "optics/lens.h"
+#include "optics/trace.h"
 
 /* The kernel's ray, in long double. */
 typedef struct ld_vec { long double x, y, z; } ld_vec;

@@ -3,7 +3,7 @@
 #define LENS2POV_TEST_SUPPORT_H
 
 #include <stddef.h>
-#include "vec3.h"
+#include "base/vec3.h"
 
 #ifndef LENS2POV_SOURCE_DIR
 #define LENS2POV_SOURCE_DIR "."

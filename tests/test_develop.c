@@ -9,9 +9,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "develop.h"
-#include "image_io.h"
-#include "samplemap.h"
+#include "image/develop.h"
+#include "image/image_io.h"
+#include "image/samplemap.h"
 
 /* ---- helpers (static: other test files have their own) ---- */
 

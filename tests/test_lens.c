@@ -1,4 +1,4 @@
-/* Tests of src/lens.c: the reader's errors (status and line), the awkward files it must take,
+/* Tests of src/optics/lens.c: the reader's errors (status and line), the awkward files it must take,
    the four shipped prescriptions against their published tables, placement, sag and copying. */
 #include <criterion/criterion.h>
 
@@ -11,7 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "lens.h"
+#include "optics/lens.h"
 
 /* ---- helpers ---------------------------------------------------------------------------- */
 

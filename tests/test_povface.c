@@ -4,7 +4,7 @@
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdint.h>
-#include "povface.h"
+#include "raytable/povface.h"
 
 /* The ray POV-Ray makes of the face (p, q, r). */
 static void face_ray(vec3 p, vec3 q, vec3 r, vec3 *o, vec3 *d)

@@ -1,4 +1,4 @@
-/* Running the real POV-Ray through src/povray.c on a hand-written mesh_camera include: a 4x2
+/* Running the real POV-Ray through src/povray/povray.c on a hand-written mesh_camera include: a 4x2
    ray table (one triangle per ray: origin = centroid, direction = normalize((P3-P1) x (P2-P1)),
    rendered 4x3 because of the row bug FS#254), the gamma of old and new scenes, POV-Ray's
    own error lines, chunks in parallel and stopping them on a failure. No .timeout: with it,
@@ -14,7 +14,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include "povray.h"
+#include "povray/povray.h"
 
 /* ---------------------------------------------------------------- files */
 

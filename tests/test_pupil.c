@@ -8,9 +8,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "camera.h"
+#include "camera/camera.h"
 #include "support.h"
-#include "trace_batch.h"
+#include "optics/trace_batch.h"
 
 static const char *const LENSES[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm",
                                      "telephoto.250mm"};

@@ -14,7 +14,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include "image_io.h"
+#include "image/image_io.h"
 #include "support.h"
 
 #define DGAUSS LENS_DIR "dgauss.50mm.dat"

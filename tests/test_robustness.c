@@ -21,7 +21,7 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
-#include "outfile.h"
+#include "base/outfile.h"
 #include "support.h"
 
 extern char **environ;

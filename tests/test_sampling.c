@@ -5,7 +5,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
-#include "film.h"
+#include "camera/film.h"
 
 /* ---- The sample pattern as first written: per-sample pixel hash, % and / by gx. */
 

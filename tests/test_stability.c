@@ -64,9 +64,9 @@
 #include <string.h>
 #include <sys/file.h>
 #include <unistd.h>
-#include "camera.h"
-#include "cli.h"
-#include "image_io.h"
+#include "camera/camera.h"
+#include "cli/cli.h"
+#include "image/image_io.h"
 #include "precision_trace.h"
 #include "support.h"
 

@@ -4,9 +4,9 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include "lens.h"
+#include "optics/lens.h"
 #include "support.h"
-#include "thicklens.h"
+#include "optics/thicklens.h"
 
 /* R1 = 50, R2 = -50, t = 6, n = 1.5, then the stop 10 mm behind the lens. */
 static const double R1 = 50, R2 = -50, T = 6, N = 1.5, GAP = 10;

@@ -5,9 +5,9 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-#include "lens.h"
+#include "optics/lens.h"
 #include "support.h"
-#include "trace.h"
+#include "optics/trace.h"
 
 static lens_surface sphere(double radius, double vertex_z)
 {
@@ -151,7 +151,7 @@ Test(trace, apertures_clip)
    operations in the same order: the same status and bit-identical rays, for every lens and
    batch sizes around the lane counts (8, 16, 32). Rays that come in blocked (every fifth, and
    a whole step of 32 in the full batch) hold NaN and must stay blocked, untouched. */
-#include "trace_batch.h"
+#include "optics/trace_batch.h"
 
 /* Returns the rays that passed; *traced counts those traced. */
 static int check_batch(const lens *l, const char *name, int n, int *traced)

@@ -8,9 +8,9 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
-#include "camera.h"
-#include "raytable.h"
-#include "trace_batch.h"
+#include "camera/camera.h"
+#include "raytable/raytable.h"
+#include "optics/trace_batch.h"
 
 static double now(void)
 {

@@ -11,8 +11,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "camera.h"
-#include "lens.h"
+#include "camera/camera.h"
+#include "optics/lens.h"
 
 #define NAME "fuzz.dat"
 

@@ -10,9 +10,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "camera.h"
-#include "cli.h"
-#include "lens.h"
+#include "camera/camera.h"
+#include "cli/cli.h"
+#include "optics/lens.h"
 
 static const char DGAUSS[] =
     "29.475 3.76 1.67 25.2\n84.83 0.12 1 25.2\n19.275 4.025 1.67 23\n40.77 3.275 1.699 23\n"

@@ -25,7 +25,7 @@ mkdir -p "$out/obj"
 # Every C source but main.c, instrumented for coverage (fuzzer-no-link), into an archive: the
 # link then takes only the objects a target needs (no OpenImageIO, no POV-Ray runner).
 objs=
-for src in "$root"/src/*.c; do
+for src in "$root"/src/*/*.c; do
     name=$(basename "$src" .c)
     [ "$name" = main ] && continue
     $cc $cflags $san -fsanitize=fuzzer-no-link -c "$src" -o "$out/obj/$name.o"

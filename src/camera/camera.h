@@ -1,0 +1,73 @@
+/* One film sample to one world ray with its weight; focusing, aperture and placement. */
+#ifndef LENS2POV_CAMERA_H
+#define LENS2POV_CAMERA_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include "base/error.h"
+#include "camera/film.h"
+#include "optics/lens.h"
+#include "optics/pupil.h"
+#include "optics/thicklens.h"
+#include "optics/trace.h"
+#include "optics/trace_batch.h"
+
+typedef enum trace_kind { TRACE_KIND_FULL, TRACE_KIND_THICK } trace_kind;
+typedef enum weighting { WEIGHTING_NORMALIZED, WEIGHTING_PHYSICAL } weighting;
+
+/* The camera options of the command line. NAN (or 0 for the integers) means "not given". */
+typedef struct camera_options {
+    int width, height, spp;
+    double film_diagonal_mm;
+    double film_distance_mm, focus_distance_units;  /* at most one; INFINITY focuses at infinity */
+    double aperture_diameter_mm, f_number;          /* at most one */
+    pupil_kind pupil;
+    trace_kind trace;
+    vec3 location, look_at, sky;
+    double unit_mm;
+    weighting weighting;
+    uint64_t seed;
+    int crop_x0, crop_y0, crop_x1, crop_y1;          /* x1 = 0: the whole film */
+} camera_options;
+
+/* Defaults of the contract: 640x480, 16 spp, 35 mm diagonal, stop-image pupil, full tracing,
+   location <0,0,0>, look-at <0,0,1>, sky <0,1,0>, metres, normalized weights. */
+void camera_options_default(camera_options *o);
+
+typedef struct camera {
+    lens lens;                 /* at the chosen film distance and stop opening */
+    film film;
+    pupil pupil;
+    thick_lens whole;          /* thick lens of the whole lens (for --trace thick and info) */
+    trace_kind trace;
+    weighting weighting;
+    double weight_scale;       /* multiplies A cos^4 / Z^2 (1 when physical) */
+    double focus_distance_units;  /* film plane to in-focus plane; INFINITY at infinity */
+    double f_number;           /* rear focal length / entrance pupil diameter */
+    sample_pattern samples;
+    int crop_x0, crop_y0, crop_x1, crop_y1;
+    /* world_from_camera: p -> location + (p.x right + p.y up + p.z forward) / unit_mm */
+    vec3 location, right, up, forward;
+    double unit_mm;
+} camera;
+
+/* Takes ownership of the lens. Validates the options against the lens (L2P_BAD_INPUT with a
+   message for a focus closer than the lens allows, an aperture larger than the stop, ...). */
+int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err);
+void camera_free(camera *c);
+
+/* Traces the film ray from film point p toward pupil sample (u, v) through the lens. On
+   success gives the outgoing ray in camera space (origin on the front of the lens) and its
+   weight, and returns true; false when the lens blocks it. */
+bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight);
+
+/* The same for n <= CAMERA_BATCH samples at once, interleaved for speed. */
+enum { CAMERA_BATCH = TRACE_SOA_MAX };   /* one call of the batch tracer */
+void camera_trace_batch(const camera *c, const vec3 *film_points, const double *u,
+                        const double *v, int n, ray *out, double *weight, bool *passed);
+
+vec3 camera_world_from_camera_point(const camera *c, vec3 p);
+vec3 camera_world_from_camera_dir(const camera *c, vec3 d);
+
+
+#endif

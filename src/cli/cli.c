@@ -1,0 +1,343 @@
+#include "cli/cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Limits of option values (see where they are used). */
+#define UNIT_MM_LEAST 1e-3
+#define UNIT_MM_MOST 1e9
+#define JOBS_MOST 256
+#define MEMORY_MB_MOST 1073741824.0
+#define FILM_PIXELS_MOST 4294967296LL
+
+static int bad(l2p_error *err, const char *opt, const char *want, const char *got)
+{
+    return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s: expected %s, got '%s'", opt, want, got);
+}
+
+/* A whole, finite number and nothing else. */
+static bool parse_double(const char *s, double *v)
+{
+    char *end;
+    errno = 0;
+    *v = strtod(s, &end);
+    return end != s && *end == '\0' && errno == 0 && isfinite(*v);
+}
+
+static bool parse_int(const char *s, int *v)
+{
+    char *end;
+    errno = 0;
+    long x = strtol(s, &end, 10);
+    if (end == s || *end != '\0' || errno || x < -2147483647L || x > 2147483647L)
+        return false;
+    *v = (int)x;
+    return true;
+}
+
+/* "x,y,z" or "<x,y,z>", as in POV-Ray. */
+static bool parse_vec3(const char *s, vec3 *v)
+{
+    char buf[256];
+    size_t n = strlen(s);
+    if (n >= sizeof buf || n == 0)
+        return false;
+    if (s[0] == '<' && s[n - 1] == '>') {
+        memcpy(buf, s + 1, n - 2);
+        buf[n - 2] = '\0';
+    } else {
+        memcpy(buf, s, n + 1);
+    }
+    double c[3];
+    char *part = buf;
+    for (int i = 0; i < 3; i++) {
+        char *comma = strchr(part, ',');
+        if ((i < 2) != (comma != NULL))
+            return false;
+        if (comma)
+            *comma = '\0';
+        while (*part == ' ')
+            part++;
+        if (!parse_double(part, &c[i]))
+            return false;
+        part = comma ? comma + 1 : part;
+    }
+    *v = v3(c[0], c[1], c[2]);
+    return true;
+}
+
+/* "X0,Y0,X1,Y1", four whole numbers (strtol, not sscanf's %d: out-of-range digits are
+   refused instead of being undefined behaviour). */
+static bool parse_crop(const char *s, camera_options *o)
+{
+    int v[4];
+    char buf[128];
+    if (strlen(s) >= sizeof buf)
+        return false;
+    memcpy(buf, s, strlen(s) + 1);
+    char *part = buf;
+    for (int i = 0; i < 4; i++) {
+        char *comma = strchr(part, ',');
+        if ((i < 3) != (comma != NULL))
+            return false;
+        if (comma)
+            *comma = '\0';
+        if (!parse_int(part, &v[i]))
+            return false;
+        part = comma ? comma + 1 : part;
+    }
+    o->crop_x0 = v[0];
+    o->crop_y0 = v[1];
+    o->crop_x1 = v[2];
+    o->crop_y1 = v[3];
+    return v[0] >= 0 && v[1] >= 0 && v[2] > v[0] && v[3] > v[1];
+}
+
+static int positive_int(const char *opt, const char *v, int *out, l2p_error *err)
+{
+    if (!parse_int(v, out) || *out <= 0)
+        return bad(err, opt, "a positive whole number", v);
+    return L2P_OK;
+}
+
+static int positive_double(const char *opt, const char *v, double *out, l2p_error *err)
+{
+    if (!parse_double(v, out) || !(*out > 0.0))
+        return bad(err, opt, "a positive number", v);
+    return L2P_OK;
+}
+
+/* A whole number in [1, most]. */
+static int int_up_to(const char *opt, const char *v, int most, int *out, l2p_error *err)
+{
+    if (!parse_int(v, out) || *out <= 0 || *out > most) {
+        char want[64];
+        snprintf(want, sizeof want, "a whole number from 1 to %d", most);
+        return bad(err, opt, want, v);
+    }
+    return L2P_OK;
+}
+
+/* A number in [least, most]. */
+static int double_in(const char *opt, const char *v, double least, double most, double *out,
+                     l2p_error *err)
+{
+    if (!parse_double(v, out) || !(*out >= least && *out <= most)) {
+        char want[96];
+        snprintf(want, sizeof want, "a number from %g to %g", least, most);
+        return bad(err, opt, want, v);
+    }
+    return L2P_OK;
+}
+
+static int film_option(cli *c, const char *opt, const char *v, l2p_error *err)
+{
+    camera_options *o = &c->cam;
+    c->film_given = true;
+    if (!strcmp(opt, "--width"))
+        return positive_int(opt, v, &o->width, err);
+    if (!strcmp(opt, "--height"))
+        return positive_int(opt, v, &o->height, err);
+    if (!strcmp(opt, "--spp"))
+        return positive_int(opt, v, &o->spp, err);
+    if (!strcmp(opt, "--film-diagonal"))
+        return positive_double(opt, v, &o->film_diagonal_mm, err);
+    if (!strcmp(opt, "--film-distance")) {
+        if (!parse_double(v, &o->film_distance_mm) || o->film_distance_mm < 0.0)
+            return bad(err, opt, "a distance in mm, 0 or more", v);
+        return L2P_OK;
+    }
+    if (!strcmp(opt, "--focus-distance")) {
+        if (!strcmp(v, "inf") || !strcmp(v, "infinity")) {
+            o->focus_distance_units = INFINITY;
+            return L2P_OK;
+        }
+        return positive_double(opt, v, &o->focus_distance_units, err);
+    }
+    if (!strcmp(opt, "--crop"))
+        return parse_crop(v, o) ? L2P_OK : bad(err, opt, "X0,Y0,X1,Y1 with X1 > X0 >= 0 and Y1 > Y0 >= 0", v);
+    return -1;
+}
+
+static int lens_option(cli *c, const char *opt, const char *v, l2p_error *err)
+{
+    camera_options *o = &c->cam;
+    if (!strcmp(opt, "--aperture-diameter"))
+        return positive_double(opt, v, &o->aperture_diameter_mm, err);
+    if (!strcmp(opt, "--f-number"))
+        return positive_double(opt, v, &o->f_number, err);
+    if (!strcmp(opt, "--pupil"))
+        return pupil_kind_parse(v, &o->pupil) ? bad(err, opt, "stop, rear or stop-image", v) : 0;
+    if (!strcmp(opt, "--trace")) {
+        if (strcmp(v, "full") && strcmp(v, "thick"))
+            return bad(err, opt, "full or thick", v);
+        o->trace = strcmp(v, "thick") ? TRACE_KIND_FULL : TRACE_KIND_THICK;
+        return L2P_OK;
+    }
+    if (!strcmp(opt, "--weighting")) {
+        if (strcmp(v, "normalized") && strcmp(v, "physical"))
+            return bad(err, opt, "normalized or physical", v);
+        o->weighting = strcmp(v, "physical") ? WEIGHTING_NORMALIZED : WEIGHTING_PHYSICAL;
+        return L2P_OK;
+    }
+    if (!strcmp(opt, "--seed")) {
+        char *end;
+        errno = 0;
+        unsigned long long s = strtoull(v, &end, 10);
+        if (end == v || *end || errno || v[0] == '-')
+            return bad(err, opt, "a whole number, 0 or more", v);
+        o->seed = s;
+        return L2P_OK;
+    }
+    return -1;
+}
+
+static int place_option(cli *c, const char *opt, const char *v, l2p_error *err)
+{
+    camera_options *o = &c->cam;
+    if (!strcmp(opt, "--location"))
+        return parse_vec3(v, &o->location) ? 0 : bad(err, opt, "x,y,z", v);
+    if (!strcmp(opt, "--look-at"))
+        return parse_vec3(v, &o->look_at) ? 0 : bad(err, opt, "x,y,z", v);
+    if (!strcmp(opt, "--sky"))
+        return parse_vec3(v, &o->sky) ? 0 : bad(err, opt, "x,y,z", v);
+    /* Millimetres in a scene unit: from a micrometre to a thousand kilometres. Beyond, the
+       ray table's triangles (a lens aperture in scene units) leave float32, which is how
+       POV-Ray stores mesh vertices: they overflow to infinity or collapse to a point. */
+    if (!strcmp(opt, "--unit-mm"))
+        return double_in(opt, v, UNIT_MM_LEAST, UNIT_MM_MOST, &o->unit_mm, err);
+    return -1;
+}
+
+static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
+{
+    if (!strcmp(opt, "-o") || !strcmp(opt, "--output"))
+        c->output = v;
+    else if (!strcmp(opt, "--rays"))
+        c->rays_csv = v;
+    else if (!strcmp(opt, "--keep-temp"))
+        c->keep_temp = v;
+    else if (!strcmp(opt, "--jobs"))   /* outfile.c stops at most 256 children on a signal */
+        return int_up_to(opt, v, JOBS_MOST, &c->jobs, err);
+    else if (!strcmp(opt, "--memory-mb"))  /* up to 1 PiB: render converts it to a face count */
+        return positive_double(opt, v, &c->memory_mb, err) ? L2P_BAD_INPUT
+               : c->memory_mb > MEMORY_MB_MOST ? bad(err, opt, "a positive number up to 1073741824", v)
+                                               : L2P_OK;
+    else
+        return -1;
+    if (!*v)
+        return bad(err, opt, "a file name", v);
+    return L2P_OK;
+}
+
+static int value_option(cli *c, const char *opt, const char *v, l2p_error *err)
+{
+    int st = film_option(c, opt, v, err);
+    if (st < 0)
+        st = lens_option(c, opt, v, err);
+    if (st < 0)
+        st = place_option(c, opt, v, err);
+    if (st < 0)
+        st = run_option(c, opt, v, err);
+    if (st < 0)
+        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unknown option '%s' (see lens2pov --help)", opt);
+    return st;
+}
+
+/* --rays naming one of the other outputs: both would be renamed into place, the last wins. */
+static bool same_output(const char *rays, const char *output)
+{
+    static const char *const ext[] = {"", ".inc", ".ini", ".map"};
+    const size_t n = strlen(output);
+    for (int i = 0; i < 4; i++)
+        if (!strncmp(rays, output, n) && !strcmp(rays + n, ext[i]))
+            return true;
+    return false;
+}
+
+static int check_contradictions(const cli *c, l2p_error *err)
+{
+    const camera_options *o = &c->cam;
+    /* The sample map numbers film pixels y * width + x in 32 bits. */
+    if ((long long)o->width * o->height > FILM_PIXELS_MOST)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--width %d x --height %d is %lld pixels: at most %lld (2^32)", o->width,
+                        o->height, (long long)o->width * o->height, FILM_PIXELS_MOST);
+    if (c->rays_csv && c->output && same_output(c->rays_csv, c->output))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--rays %s would overwrite an output of -o %s: give another file",
+                        c->rays_csv, c->output);
+    if (!isnan(o->film_distance_mm) && !isnan(o->focus_distance_units))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--film-distance and --focus-distance both set the focus: give one");
+    if (!isnan(o->aperture_diameter_mm) && !isnan(o->f_number))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--aperture-diameter and --f-number both set the aperture: give one");
+    if (o->crop_x1 && (o->crop_x1 > o->width || o->crop_y1 > o->height))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--crop %d,%d,%d,%d reaches outside the %dx%d film (X1, Y1 exclusive)",
+                        o->crop_x0, o->crop_y0, o->crop_x1, o->crop_y1, o->width, o->height);
+    return L2P_OK;
+}
+
+static bool is_flag(cli *c, const char *a)
+{
+    if (!strcmp(a, "--json"))
+        c->json = true;
+    else if (!strcmp(a, "--quiet") || !strcmp(a, "-q"))
+        c->quiet = true;
+    else
+        return false;
+    return true;
+}
+
+int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
+{
+    memset(c, 0, sizeof *c);
+    camera_options_default(&c->cam);
+    for (int i = first; i < argc; i++) {
+        const char *a = argv[i];
+        if (is_flag(c, a))
+            continue;
+        if (a[0] != '-' || a[1] == '\0') {
+            if (c->positional_count == CLI_MAX_POSITIONAL)
+                return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unexpected argument '%s'", a);
+            c->positional[c->positional_count++] = a;
+            continue;
+        }
+        const char *eq = strchr(a, '=');
+        char opt[64];
+        const char *value;
+        if (eq && a[1] == '-' && (size_t)(eq - a) < sizeof opt) {
+            memcpy(opt, a, (size_t)(eq - a));
+            opt[eq - a] = '\0';
+            value = eq + 1;
+        } else {
+            snprintf(opt, sizeof opt, "%s", a);
+            if (i + 1 >= argc)
+                return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s needs a value", opt);
+            value = argv[++i];
+        }
+        int st = value_option(c, opt, value, err);
+        if (st)
+            return st;
+    }
+    return check_contradictions(c, err);
+}
+
+void cli_warn(const cli *c, const camera *cam)
+{
+    /* A film nearer the lens than its focal plane images a virtual object: nothing in front of
+       the lens is sharp. */
+    if (!isnan(c->cam.film_distance_mm) && !(cam->focus_distance_units > 0.0))
+        fprintf(stderr, "lens2pov: warning: --film-distance %g mm focuses %g units behind the "
+                        "film: nothing in the scene is sharp\n", c->cam.film_distance_mm,
+                -cam->focus_distance_units);
+    if (c->cam.pupil == PUPIL_STOP && c->cam.trace == TRACE_KIND_FULL)
+        fprintf(stderr, "lens2pov: warning: --pupil stop aims at the stop's own disk, which misses "
+                        "rays the lens passes: the picture comes out too dark (a diagnostic; "
+                        "stop-image and rear are unbiased)\n");
+}

@@ -1,0 +1,33 @@
+/* The command line: options common to the commands, parsed strictly. Every bad value is
+   refused with L2P_BAD_INPUT and a message naming the option. */
+#ifndef LENS2POV_CLI_H
+#define LENS2POV_CLI_H
+
+#include <stdbool.h>
+#include "camera/camera.h"
+#include "base/error.h"
+
+enum { CLI_MAX_POSITIONAL = 256 };
+
+typedef struct cli {
+    camera_options cam;
+    const char *positional[CLI_MAX_POSITIONAL];
+    int positional_count;
+    const char *output;          /* -o */
+    const char *rays_csv;        /* --rays */
+    const char *keep_temp;       /* --keep-temp */
+    int jobs;                    /* --jobs, 0: the number of cores */
+    double memory_mb;            /* --memory-mb: POV-Ray memory budget per process (chunks) */
+    bool json;                   /* --json */
+    bool quiet;                  /* --quiet: no progress bar */
+    bool film_given;             /* any film or focus option was given (info prints more) */
+} cli;
+
+/* Parses argv[first..argc-1]. */
+int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
+
+/* Warns on stderr about choices that give a picture the user may not expect: --pupil stop
+   (biased on purpose), a film distance that puts the focus behind the camera. */
+void cli_warn(const cli *c, const camera *cam);
+
+#endif

@@ -1,0 +1,125 @@
+#include "cli/info.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
+{
+    lens l;
+    if (lens_copy(&l, src))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    l.stop_diameter_mm = l.surface[l.stop].aperture_mm;
+    lens_set_film_distance(&l, 0.0);
+    thick_lens t;
+    pupil exit;
+    double ep_z, ep_r;
+    int st = thick_lens_of(&l, 0, l.count - 1, &t, err);
+    if (!st)
+        st = pupil_stop_image(&l, false, &ep_z, &ep_r, err);
+    if (!st)
+        st = pupil_make(&l, PUPIL_STOP_IMAGE, &exit, err);
+    if (!st) {
+        memset(out, 0, sizeof *out);
+        out->efl_mm = thick_efl_mm(&t);
+        out->bfd_mm = -t.f2_mm;   /* rear vertex (z = 0 here) to F2, toward the film */
+        out->ffd_mm = t.f1_mm - l.surface[0].vertex_z_mm;
+        out->f_number = out->efl_mm / (2.0 * ep_r);
+        out->stop_diameter_mm = l.stop_diameter_mm;
+        out->total_length_mm = lens_total_length_mm(&l);
+        out->p1_from_rear_mm = t.p1_mm;
+        out->p2_from_rear_mm = t.p2_mm;
+        out->entrance_pupil_from_rear_mm = ep_z;
+        out->entrance_pupil_diameter_mm = 2.0 * ep_r;
+        out->exit_pupil_from_rear_mm = exit.z_mm;
+        out->exit_pupil_diameter_mm = 2.0 * exit.radius_mm;
+    }
+    lens_free(&l);
+    return st;
+}
+
+/* Half field angle, degrees: the ray from film point p through the middle of the pupil region
+   sampled for it, traced out of the lens. Where the lens passes nothing from p (beyond a
+   fisheye's image circle) the field ends at the image circle: the film point is moved toward
+   the centre, by bisection, to the last place its ray passes. NAN when even the centre's is
+   blocked. */
+static double half_field_deg(const camera *c, vec3 p)
+{
+    ray r;
+    double w, in = 1.0, out = 1.0;
+    if (!camera_trace(c, p, 0.5, 0.5, &r, &w)) {
+        if (!camera_trace(c, v3(0, 0, 0), 0.5, 0.5, &r, &w))
+            return NAN;
+        in = 0.0;
+        for (int k = 0; k < 60; k++) {
+            const double mid = 0.5 * (in + out);
+            *(camera_trace(c, v3_scale(p, mid), 0.5, 0.5, &r, &w) ? &in : &out) = mid;
+        }
+        camera_trace(c, v3_scale(p, in), 0.5, 0.5, &r, &w);
+    }
+    return acos(fmin(1.0, r.d.z)) * 180.0 / M_PI;
+}
+
+typedef struct field { const char *key, *label, *unit; double value; } field;
+
+static void print_fields(FILE *out, const field *f, int n, bool json)
+{
+    for (int i = 0; i < n; i++) {
+        const char *comma = i + 1 < n ? "," : "";
+        if (json && isfinite(f[i].value))
+            fprintf(out, "  \"%s\": %.10g%s\n", f[i].key, f[i].value, comma);
+        else if (json)
+            fprintf(out, "  \"%s\": null%s\n", f[i].key, comma);
+        else
+            fprintf(out, "%-34s %12.6g %s\n", f[i].label, f[i].value, f[i].unit);
+    }
+}
+
+void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, bool json)
+{
+    field f[32] = {
+        {"efl_mm", "effective focal length", "mm", li->efl_mm},
+        {"bfd_mm", "back focal distance", "mm", li->bfd_mm},
+        {"ffd_mm", "front focal distance", "mm", li->ffd_mm},
+        {"f_number", "f-number at full stop", "", li->f_number},
+        {"stop_diameter_mm", "stop diameter", "mm", li->stop_diameter_mm},
+        {"total_length_mm", "total length (front to rear vertex)", "mm", li->total_length_mm},
+        {"front_principal_plane_mm", "front principal plane (from rear)", "mm", li->p1_from_rear_mm},
+        {"rear_principal_plane_mm", "rear principal plane (from rear)", "mm", li->p2_from_rear_mm},
+        {"entrance_pupil_mm", "entrance pupil (from rear)", "mm", li->entrance_pupil_from_rear_mm},
+        {"entrance_pupil_diameter_mm", "entrance pupil diameter", "mm", li->entrance_pupil_diameter_mm},
+        {"exit_pupil_mm", "exit pupil (from rear)", "mm", li->exit_pupil_from_rear_mm},
+        {"exit_pupil_diameter_mm", "exit pupil diameter", "mm", li->exit_pupil_diameter_mm},
+    };
+    int n = 12;
+    if (c) {
+        const film *fi = &c->film;
+        field more[] = {
+            {"film_distance_mm", "film distance", "mm", c->lens.film_distance_mm},
+            {"focus_distance", "focus distance (film to subject)", "units", c->focus_distance_units},
+            {"working_f_number", "f-number (this aperture)", "", c->f_number},
+            {"aperture_diameter_mm", "aperture diameter", "mm", c->lens.stop_diameter_mm},
+            {"hfov_deg", "horizontal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0, 0))},
+            {"vfov_deg", "vertical field of view", "deg", 2 * half_field_deg(c, v3(0, 0.5 * fi->height_mm, 0))},
+            {"dfov_deg", "diagonal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0.5 * fi->height_mm, 0))},
+            /* Only where the lens passes nothing beyond it (a fisheye's image circle). */
+            {"image_circle_mm", "image circle diameter", "mm",
+             isfinite(c->pupil.reach_mm) ? 2.0 * c->pupil.reach_mm : NAN},
+        };
+        memcpy(f + n, more, sizeof more);
+        n += (int)(sizeof more / sizeof more[0]);
+        if (!json && !isfinite(f[n - 1].value))
+            n--;   /* no image circle: the lens covers the film (JSON says null) */
+    }
+    if (json) {
+        fputs("{\n  \"lens\": \"", out);
+        for (const char *p = l->name; *p; p++)
+            fprintf(out, *p == '"' || *p == '\\' ? "\\%c" : (unsigned char)*p < 32 ? "\\u%04x" : "%c", *p);
+        fputs("\",\n", out);
+    }
+    else
+        fprintf(out, "%s (%d surfaces, stop on line %d)\n", l->path, l->count,
+                l->surface[l->stop].line);
+    print_fields(out, f, n, json);
+    if (json)
+        fprintf(out, "}\n");
+}

@@ -1,0 +1,349 @@
+#include "cli/render.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include "camera/camera.h"
+#include "image/develop.h"
+#include "image/image_io.h"
+#include "base/outfile.h"
+#include "povray/povray.h"
+#include "raytable/raytable.h"
+
+static int check_inputs(const cli *c, l2p_error *err)
+{
+    if (c->positional_count != 2)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "render takes SCENE.pov LENS (see --help)");
+    if (!c->output)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "-o is required");
+    const char *dot = strrchr(c->output, '.');
+    if (!dot || (strcasecmp(dot, ".png") && strcasecmp(dot, ".exr") && strcasecmp(dot, ".tif") &&
+                 strcasecmp(dot, ".tiff")))
+        return l2p_fail(err, L2P_BAD_INPUT, c->output, 0, "unknown image type (use .png, .exr or .tif)");
+    FILE *f = fopen(c->positional[0], "r");
+    if (!f)
+        return l2p_fail(err, L2P_BAD_INPUT, c->positional[0], 0, "cannot read: %s", strerror(errno));
+    fclose(f);
+    /* Before any work: a render of minutes must not fail at its last step. */
+    int st = outfile_check_path(c->output, err);
+    if (!st && c->rays_csv)
+        st = outfile_check_path(c->rays_csv, err);
+    return st;
+}
+
+static int number_of_cores(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int)n : 1;
+}
+
+/* Chunks small enough for the memory budget, as many as a multiple of the jobs and with the
+   same number of faces, so that the parses, which POV-Ray does on one thread, run side by side
+   and end together (3 chunks on 2 jobs would take two rounds for one and a half chunks' work).
+   Returns the faces a chunk; *chunks gets their number (fewer when there are fewer faces). */
+static long long chunk_faces_for(const camera *cam, const cli *c, int jobs, int *chunks)
+{
+    const long long budget = raytable_faces_for_memory(c->memory_mb);
+    long long faces = raytable_count_faces(cam);
+    if (faces < 0)   /* out of memory to count: every sample, an upper bound */
+        faces = (long long)(cam->crop_x1 - cam->crop_x0) * (cam->crop_y1 - cam->crop_y0) *
+                cam->samples.spp;
+    const long long needed = (faces + budget - 1) / budget;
+    const long long count = needed < 1 ? jobs : (needed + jobs - 1) / jobs * jobs;
+    const long long per_chunk = (faces + count - 1) / count;
+    *chunks = (int)count;
+    return per_chunk > 0 ? per_chunk : 1;
+}
+
+typedef struct workspace {
+    char dir[4096];
+    bool keep;
+} workspace;
+
+static void remove_workspace(const workspace *w);
+
+/* Workspaces are named lens2pov.PID.XXXXXX. One whose process is gone (killed with SIGKILL,
+   which no handler sees) is removed by the next render that looks in the same folder, when it
+   is ours: so they never pile up. A process id taken again by another process keeps its
+   folder until that one ends too. */
+static void remove_stale_workspaces(const char *tmp)
+{
+    DIR *d = opendir(tmp);
+    if (!d)
+        return;
+    for (struct dirent *e; (e = readdir(d)) != NULL;) {
+        long pid;
+        char rest[16];
+        if (sscanf(e->d_name, "lens2pov.%ld.%15s", &pid, rest) != 2 || strlen(rest) != 6 ||
+            pid <= 0 || (kill((pid_t)pid, 0) == 0 || errno != ESRCH))
+            continue;
+        workspace stale = {.keep = false};
+        struct stat sb;
+        snprintf(stale.dir, sizeof stale.dir, "%s/%s", tmp, e->d_name);
+        if (lstat(stale.dir, &sb) == 0 && S_ISDIR(sb.st_mode) && sb.st_uid == getuid())
+            remove_workspace(&stale);
+    }
+    closedir(d);
+}
+
+static int make_workspace(workspace *w, const cli *c, l2p_error *err)
+{
+    w->keep = c->keep_temp != NULL;
+    if (w->keep) {
+        snprintf(w->dir, sizeof w->dir, "%s", c->keep_temp);
+        if (mkdir(w->dir, 0777) != 0 && errno != EEXIST)
+            return l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "cannot make folder: %s", strerror(errno));
+        return L2P_OK;
+    }
+    const char *tmp = getenv("TMPDIR");
+    tmp = tmp && *tmp ? tmp : "/tmp";
+    remove_stale_workspaces(tmp);
+    snprintf(w->dir, sizeof w->dir, "%s/lens2pov.%ld.XXXXXX", tmp, (long)getpid());
+    if (!mkdtemp(w->dir))
+        return l2p_fail(err, L2P_FAILED, w->dir, 0, "cannot make a temporary folder: %s",
+                        strerror(errno));
+    outfile_track(w->dir);
+    return L2P_OK;
+}
+
+/* Removes the workspace and its files (nothing in it has folders). */
+static void remove_workspace(const workspace *w)
+{
+    if (w->keep)
+        return;
+    DIR *d = opendir(w->dir);
+    if (d) {
+        char path[8192];
+        for (struct dirent *e; (e = readdir(d)) != NULL;)
+            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+                snprintf(path, sizeof path, "%s/%s", w->dir, e->d_name);
+                unlink(path);
+            }
+        closedir(d);
+    }
+    rmdir(w->dir);
+    outfile_untrack(w->dir);
+}
+
+/* The ray table is written on a thread of its own, and POV-Ray starts on each chunk as soon as
+   it is complete; the image library (0.3 s to load) loads meanwhile. The --rays CSV is
+   written in the workspace and handed to the user only when the render succeeds. */
+typedef struct writer {
+    const camera *cam;
+    const cli *c;
+    char prefix[8192], csv[8300];
+    long long chunk_faces;
+    pthread_mutex_t lock;
+    int ready, total;          /* chunks complete; their count once done (-1 before) */
+    atomic_bool stop;          /* from the renderer: stop at the next row */
+    int status;
+    l2p_error err;
+} writer;
+
+static int chunk_done(void *ctx, int index)
+{
+    writer *w = ctx;
+    pthread_mutex_lock(&w->lock);
+    w->ready = index + 1;
+    pthread_mutex_unlock(&w->lock);
+    return atomic_load(&w->stop);
+}
+
+static void *write_table(void *arg)
+{
+    writer *w = arg;
+    l2p_error err;
+    int count = 0;
+    const raytable_stream stream = {chunk_done, w, &w->stop};
+    const int st = raytable_write(w->cam, w->prefix, w->c->rays_csv ? w->csv : NULL,
+                                  w->chunk_faces, !w->c->quiet, &stream, &count, NULL, &err);
+    pthread_mutex_lock(&w->lock);
+    w->status = st;
+    if (st)
+        w->err = err;
+    w->total = st ? w->ready : count;
+    pthread_mutex_unlock(&w->lock);
+    return NULL;
+}
+
+static int chunks_ready(void *ctx, int *ready, int *total, l2p_error *err)
+{
+    writer *w = ctx;
+    pthread_mutex_lock(&w->lock);
+    *ready = w->ready;
+    *total = w->total;
+    const int st = w->status;
+    if (st)
+        *err = w->err;
+    pthread_mutex_unlock(&w->lock);
+    return st;
+}
+
+static void *load_image_library(void *arg)
+{
+    (void)arg;
+    image_io_ready(NULL);
+    return NULL;
+}
+
+static void free_chunk_list(povray_chunk *pc, int count)
+{
+    for (int i = 0; pc && i < count; i++) {
+        free((char *)pc[i].include_path);
+        free((char *)pc[i].ini_path);
+        free((char *)pc[i].output_exr);
+    }
+    free(pc);
+}
+
+/* The chunks the writer will write, by name; NULL out of memory. */
+static povray_chunk *chunk_list(const writer *w, int count, long long faces)
+{
+    povray_chunk *pc = calloc((size_t)count, sizeof *pc);
+    for (int i = 0; pc && i < count; i++) {
+        char *inc = povmesh_chunk_file(w->prefix, true, i, "inc");
+        char *ini = povmesh_chunk_file(w->prefix, true, i, "ini");
+        char *exr = povmesh_chunk_file(w->prefix, true, i, "exr");
+        pc[i] = (povray_chunk){inc, ini, exr, faces};
+        if (!inc || !ini || !exr) {
+            free_chunk_list(pc, i + 1);
+            return NULL;
+        }
+    }
+    return pc;
+}
+
+/* Every chunk's EXR developed into the output through the writer's sample map. */
+static int develop_chunks(const cli *c, const writer *w, const povray_chunk *pc, int count,
+                          l2p_error *err)
+{
+    const char **exrs = calloc((size_t)(count > 0 ? count : 1), sizeof *exrs);
+    if (!exrs)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i = 0; i < count; i++)
+        exrs[i] = pc[i].output_exr;
+    char map_path[8300];
+    snprintf(map_path, sizeof map_path, "%s.map", w->prefix);
+    samplemap map;
+    int st = samplemap_read(map_path, &map, err);
+    if (!st) {
+        st = develop_files(&map, exrs, count, c->output, err);
+        samplemap_free(&map);
+    }
+    free(exrs);
+    return st;
+}
+
+/* The workspace's CSV into the user's (opened at the start, so that a bad path fails at
+   once): renamed onto its temporary name, or copied when on another file system; then
+   committed. */
+static int publish_csv(const char *from, outfile *out, l2p_error *err)
+{
+    if (rename(from, out->temp_path) != 0) {
+        if (errno != EXDEV)
+            return l2p_fail(err, L2P_FAILED, out->final_path, 0, "cannot write: %s",
+                            strerror(errno));
+        FILE *in = fopen(from, "rb");
+        if (!in)
+            return l2p_fail(err, L2P_FAILED, from, 0, "cannot read: %s", strerror(errno));
+        char buf[1 << 16];
+        int st = L2P_OK;
+        for (size_t n; !st && (n = fread(buf, 1, sizeof buf, in)) > 0;)
+            if (fwrite(buf, 1, n, out->fp) != n)
+                st = l2p_fail(err, L2P_FAILED, out->final_path, 0, "write failed");
+        if (!st && ferror(in))
+            st = l2p_fail(err, L2P_FAILED, from, 0, "read failed");
+        fclose(in);
+        if (st)
+            return st;
+    }
+    return outfile_commit(out, err);
+}
+
+/* Starts a thread with SIGINT, SIGTERM and SIGHUP blocked, so that they reach the main thread,
+   whose handler stops the POV-Ray processes it tracks. */
+static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
+{
+    sigset_t old;
+    outfile_block_signals(&old);
+    const int r = pthread_create(t, NULL, fn, arg);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return r;
+}
+
+/* Writes the table and renders its chunks side by side, then develops them. */
+static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
+                            outfile *csv, l2p_error *err)
+{
+    writer w = {.cam = cam, .c = c, .total = -1};
+    snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
+    snprintf(w.csv, sizeof w.csv, "%s/rays.csv", ws->dir);
+    atomic_init(&w.stop, false);
+    int count;
+    w.chunk_faces = chunk_faces_for(cam, c, jobs, &count);
+    povray_chunk *pc = chunk_list(&w, count, w.chunk_faces);
+    if (!pc)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    pthread_mutex_init(&w.lock, NULL);
+    pthread_t thread;
+    int st = start_thread(&thread, write_table, &w) == 0
+                 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
+    if (!st) {
+        st = image_io_ready(err);
+        /* Every process may use every core: the chunks cost the same to parse but not to shade
+           (sky against floor), and a process left shading alone then gets the idle cores. */
+        const povray_options po = {c->positional[0], ws->dir, jobs, number_of_cores(),
+                                   !c->quiet, NULL, chunks_ready, &w};
+        if (!st)
+            st = povray_render_chunks(pc, count, &po, err);
+        if (st)
+            atomic_store(&w.stop, true);
+        pthread_join(thread, NULL);
+        if (!st && w.status)   /* failed after its last chunk: the map or the CSV */
+            st = l2p_fail(err, w.status, NULL, 0, "%s", w.err.text);
+        if (!st)
+            st = develop_chunks(c, &w, pc, w.total, err);
+        if (!st && c->rays_csv)
+            st = publish_csv(w.csv, csv, err);
+    }
+    pthread_mutex_destroy(&w.lock);
+    free_chunk_list(pc, count);
+    return st;
+}
+
+int render_command(const cli *c, l2p_error *err)
+{
+    int st = check_inputs(c, err);
+    if (st)
+        return st;
+    lens l;
+    if ((st = lens_read(c->positional[1], &l, err)))
+        return st;
+    camera cam;
+    if ((st = camera_setup(&cam, &l, &c->cam, err))) {
+        camera_free(&cam);
+        return st;
+    }
+    cli_warn(c, &cam);
+    pthread_t loader;
+    if (start_thread(&loader, load_image_library, NULL) == 0)
+        pthread_detach(loader);   /* image_io_ready waits for it */
+    const int jobs = c->jobs > 0 ? c->jobs : number_of_cores();
+    workspace w;
+    outfile csv = {0};
+    if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
+        !(st = make_workspace(&w, c, err))) {
+        st = trace_and_render(c, &cam, &w, jobs, &csv, err);
+        remove_workspace(&w);
+    }
+    outfile_discard(&csv);   /* nothing when committed */
+    camera_free(&cam);
+    return st;
+}

@@ -1,0 +1,175 @@
+#include "image/develop.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "image/image_io.h"
+
+static long long crop_width(const samplemap_header *h) { return h->crop_x1 - h->crop_x0; }
+static long long crop_height(const samplemap_header *h) { return h->crop_y1 - h->crop_y0; }
+
+/* The chunk's image must be exactly packed_width x (face rows + 1): anything else means the
+   render does not belong to this map (or POV-Ray was run with other settings). */
+static int check_chunk_image(const samplemap_header *h, long long chunk, int width, int height,
+                             l2p_error *err)
+{
+    const long long count = samplemap_chunk_count(h);
+    if (chunk < 0 || chunk >= count)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "chunk %lld does not exist (the map has %lld)",
+                        chunk, count);
+    const int rows = samplemap_chunk_rows(h, chunk);
+    if (width != h->packed_width || height != rows + 1)
+        return l2p_fail(err, L2P_FAILED, NULL, 0,
+                        "render of chunk %lld is %dx%d, expected %dx%d (packed width x face "
+                        "rows + 1): it does not belong to this sample map",
+                        chunk, width, height, h->packed_width, rows + 1);
+    return L2P_OK;
+}
+
+/* Index into the crop's pixels of a record's whole-film pixel; -1 outside the crop (a map made
+   in memory, not checked by samplemap_read). */
+static long long crop_index(const samplemap_header *h, uint32_t film_pixel)
+{
+    const long long x = film_pixel % (uint32_t)h->film_width - h->crop_x0;
+    const long long y = film_pixel / (uint32_t)h->film_width - h->crop_y0;
+    if (x < 0 || x >= crop_width(h) || y < 0 || y >= crop_height(h))
+        return -1;
+    return y * crop_width(h) + x;
+}
+
+static int add_sample(const samplemap *map, long long face, const float *rgba, double *sums,
+                      l2p_error *err)
+{
+    const samplemap_record *r = &map->records[face];
+    const long long i = crop_index(&map->header, r->film_pixel);
+    if (i < 0)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "face %lld: film pixel %lu outside the crop",
+                        face, (unsigned long)r->film_pixel);
+    for (int c = 0; c < 3; c++)
+        sums[3 * i + c] += (double)r->weight * (double)rgba[c];
+    return L2P_OK;
+}
+
+int develop_accumulate(const samplemap *map, long long chunk, const float *rgba, int width,
+                       int height, double *sums, l2p_error *err)
+{
+    const samplemap_header *h = &map->header;
+    int st = check_chunk_image(h, chunk, width, height, err);
+    if (st)
+        return st;
+    /* Image row y >= 1 shows face row y - 1 (POV-Ray 3.7.0.10, FS#254); row 0 is a duplicate. */
+    const long long first = chunk * h->chunk_faces;
+    for (int y = 1; y < height; y++)
+        for (int x = 0; x < width; x++) {
+            const long long face = first + (long long)(y - 1) * width + x;
+            if (face >= h->faces)   /* past the table: the unused end of the last row */
+                return L2P_OK;
+            st = add_sample(map, face, rgba + 4 * ((size_t)y * (size_t)width + (size_t)x),
+                            sums, err);
+            if (st)
+                return st;
+        }
+    return L2P_OK;
+}
+
+void develop_finish(const samplemap *map, const double *sums, float *rgb)
+{
+    const samplemap_header *h = &map->header;
+    const size_t n = 3 * (size_t)crop_width(h) * (size_t)crop_height(h);
+    for (size_t i = 0; i < n; i++)
+        rgb[i] = (float)(sums[i] / h->spp);
+}
+
+/* ---- the whole step ---- */
+
+/* Reads one render and adds it in; errors name the render's file. */
+static int develop_one(const samplemap *map, long long chunk, const char *path, double *sums,
+                       l2p_error *err)
+{
+    int width = 0, height = 0;
+    float *rgba = NULL;
+    int st = image_read_rgba(path, &width, &height, &rgba, err);
+    if (st)
+        return st;
+    st = develop_accumulate(map, chunk, rgba, width, height, sums, err);
+    free(rgba);
+    if (st) {
+        char text[sizeof err->text];
+        snprintf(text, sizeof text, "%s", err->text);
+        l2p_fail(err, st, path, 0, "%s", text);
+    }
+    return st;
+}
+
+/* Metadata values as text; the buffers live in the caller. */
+typedef struct metadata_text {
+    char f_number[32], focus[32], film_distance[32], diagonal[32], spp[32];
+} metadata_text;
+
+/* %.6g, with "infinity" for a focus at infinity rather than printf's "inf". */
+static void format_number(char *buf, size_t size, double v)
+{
+    if (isinf(v))
+        snprintf(buf, size, "%sinfinity", v < 0 ? "-" : "");
+    else
+        snprintf(buf, size, "%.6g", v);
+}
+
+static int fill_attributes(const samplemap_header *h, metadata_text *t, image_attribute *a)
+{
+    format_number(t->f_number, sizeof t->f_number, h->f_number);
+    format_number(t->focus, sizeof t->focus, h->focus_distance_units);
+    format_number(t->film_distance, sizeof t->film_distance, h->film_distance_mm);
+    format_number(t->diagonal, sizeof t->diagonal, h->film_diagonal_mm);
+    snprintf(t->spp, sizeof t->spp, "%d", h->spp);
+    const image_attribute list[] = {
+        {"lens2pov:lens", h->lens},          {"lens2pov:pupil", h->pupil},
+        {"lens2pov:trace", h->trace},        {"lens2pov:weighting", h->weighting},
+        {"FNumber", t->f_number},            {"lens2pov:focus_distance", t->focus},
+        {"lens2pov:film_distance_mm", t->film_distance},
+        {"lens2pov:film_diagonal_mm", t->diagonal},
+        {"lens2pov:spp", t->spp},            {"Software", "lens2pov"},
+    };
+    memcpy(a, list, sizeof list);
+    return (int)(sizeof list / sizeof list[0]);
+}
+
+static int write_picture(const samplemap *map, const double *sums, const char *out_path,
+                         l2p_error *err)
+{
+    const samplemap_header *h = &map->header;
+    float *rgb = malloc(sizeof *rgb * 3 * (size_t)crop_width(h) * (size_t)crop_height(h));
+    if (!rgb)
+        return l2p_fail(err, L2P_FAILED, out_path, 0, "out of memory");
+    develop_finish(map, sums, rgb);
+    metadata_text text;
+    image_attribute attributes[16];
+    const int count = fill_attributes(h, &text, attributes);
+    int st = image_write_rgb(out_path, (int)crop_width(h), (int)crop_height(h), rgb, attributes,
+                             count, err);
+    free(rgb);
+    return st;
+}
+
+int develop_files(const samplemap *map, const char *const *renders, int render_count,
+                  const char *out_path, l2p_error *err)
+{
+    const samplemap_header *h = &map->header;
+    const long long chunks = samplemap_chunk_count(h);
+    if (render_count != chunks)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "the sample map has %lld chunk%s but %d render%s given", chunks,
+                        chunks == 1 ? "" : "s", render_count,
+                        render_count == 1 ? " was" : "s were");
+    double *sums = calloc(3 * (size_t)crop_width(h) * (size_t)crop_height(h), sizeof *sums);
+    if (!sums)
+        return l2p_fail(err, L2P_FAILED, out_path, 0, "out of memory");
+    int st = L2P_OK;
+    for (int k = 0; k < render_count && !st; k++)
+        st = develop_one(map, k, renders[k], sums, err);
+    if (!st)
+        st = write_picture(map, sums, out_path, err);
+    free(sums);
+    return st;
+}

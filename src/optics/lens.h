@@ -1,0 +1,71 @@
+/* A lens prescription in pbrt's format: reading, validating and querying it.
+
+   One row a surface, from the scene side to the film side, millimetres:
+   radius (positive: centre of curvature on the film side; 0: the aperture stop),
+   thickness to the next surface, index of refraction behind the surface (0 on the stop row
+   means air), clear aperture diameter. Camera space puts the film at z = 0 and the lens toward
+   +z; surface i has its vertex at z = film_distance + sum of thicknesses of rows i .. n-2. */
+#ifndef LENS2POV_LENS_H
+#define LENS2POV_LENS_H
+
+#include <stddef.h>
+#include "base/error.h"
+
+typedef struct lens_surface {
+    double radius_mm;        /* signed radius of curvature; 0 on the stop row */
+    double curvature_per_mm; /* 1 / radius, 0 for the stop */
+    double thickness_mm;     /* axial distance to the next surface toward the film */
+    double ior;              /* index of the medium behind this surface; 1 where the file says 0 */
+    double aperture_mm;      /* clear aperture diameter (the stop: its largest opening) */
+    double vertex_z_mm;      /* camera space; set by lens_set_film_distance */
+    int line;                /* line of the file that gave this row */
+} lens_surface;
+
+typedef struct lens {
+    char *path;              /* as given by the user, for messages */
+    char *name;              /* file name without folders and without ".dat" */
+    lens_surface *surface;   /* surface[0] faces the scene, surface[count-1] the film */
+    int count;
+    int stop;                /* index of the aperture stop row */
+    double stop_diameter_mm; /* current opening, at most surface[stop].aperture_mm */
+    double film_distance_mm; /* rear vertex to film */
+} lens;
+
+/* Limits of lens_read and lens_parse, far above any real lens: they stop a wrong file (an
+   image, a log) from taking the memory before the parser refuses it. */
+enum { LENS_MAX_FILE_BYTES = 16 * 1024 * 1024, LENS_MAX_SURFACES = 10000 };
+
+/* Reads and validates a lens file. On failure returns L2P_BAD_INPUT with "FILE:LINE: what is
+   wrong" in err and leaves *out empty. The film distance starts at 0 (call
+   lens_set_film_distance) and the stop at its full opening. */
+int lens_read(const char *path, lens *out, l2p_error *err);
+
+/* The same from text already in memory; name is used in messages as the file name. */
+int lens_parse(const char *text, size_t length, const char *name, lens *out, l2p_error *err);
+
+void lens_free(lens *l);
+
+/* Deep copy (for tracing variants side by side). */
+int lens_copy(lens *dst, const lens *src);
+
+/* Places the surfaces in camera space for this rear-vertex-to-film distance. */
+void lens_set_film_distance(lens *l, double film_distance_mm);
+
+/* Index of refraction in front of surface i (scene side) and behind it (film side). */
+static inline double lens_ior_front(const lens *l, int i) { return i == 0 ? 1.0 : l->surface[i - 1].ior; }
+static inline double lens_ior_behind(const lens *l, int i) { return l->surface[i].ior; }
+
+/* Semi-aperture of surface i, the stop's current opening for the stop. */
+static inline double lens_semi_aperture_mm(const lens *l, int i)
+{
+    return i == l->stop ? 0.5 * l->stop_diameter_mm : 0.5 * l->surface[i].aperture_mm;
+}
+
+/* Front vertex to rear vertex: the sum of the thicknesses of rows 0 .. n-2. */
+double lens_total_length_mm(const lens *l);
+
+/* Sag of surface i at height rho: the axial offset of the surface from its vertex, positive
+   toward the scene (+z). 0 for the stop. */
+double lens_sag_mm(const lens_surface *s, double rho_mm);
+
+#endif

@@ -1,0 +1,29 @@
+#include "optics/trace.h"
+
+/* The kernel in double precision; tests/precision_trace.c builds it in long double. */
+#define KREAL double
+#define KVEC vec3
+#define KRAY ray
+#define KNAME(f) kernel_##f
+#include "optics/trace_kernel.h"
+
+trace_status trace_intersect(const lens_surface *s, ray *r, vec3 *normal)
+{
+    return kernel_intersect(s, r, normal);
+}
+
+trace_status trace_refract(vec3 n, double n1, double n2, vec3 *d)
+{
+    return kernel_refract(n, n1, n2, d);
+}
+
+trace_status trace_toward_scene(const lens *l, int first, int last, ray *r, int *blocked_at)
+{
+    return kernel_through(l, first, last, true, r, blocked_at);
+}
+
+trace_status trace_toward_film(const lens *l, int first, int last, ray *r, int *blocked_at)
+{
+    return kernel_through(l, first, last, false, r, blocked_at);
+}
+

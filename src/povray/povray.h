@@ -1,0 +1,35 @@
+/* Running POV-Ray on the chunks of a ray table: the wrapper scene, the flags, parallel
+   processes, progress and POV-Ray's own error lines. */
+#ifndef LENS2POV_POVRAY_H
+#define LENS2POV_POVRAY_H
+
+#include "base/error.h"
+
+typedef struct povray_chunk {
+    const char *include_path;  /* the chunk's camera include (PREFIX.cNNN.inc) */
+    const char *ini_path;      /* its settings (Width, Height, -A, +FE, ...) */
+    const char *output_exr;    /* where POV-Ray writes the chunk's render */
+    long long faces;           /* for progress and memory estimates */
+} povray_chunk;
+
+typedef struct povray_options {
+    const char *scene_path;    /* the user's scene, never modified */
+    const char *work_dir;      /* folder for the wrapper files and POV-Ray's logs */
+    int jobs;                  /* POV-Ray processes at once */
+    int threads_per_job;       /* +WTn for each process; 0: POV-Ray's default */
+    int show_progress;         /* draw a progress bar on stderr */
+    const char *povray;        /* the executable; NULL: "povray" (or $LENS2POV_POVRAY) */
+    /* Chunks still being written (NULL: all are ready): how many are ready now, in order, and
+       in *total the final count once the writer is done (-1 before; at most the count given to
+       povray_render_chunks). Nonzero: the writer failed, with err set. */
+    int (*chunks_ready)(void *ctx, int *ready, int *total, l2p_error *err);
+    void *ctx;
+} povray_options;
+
+/* Writes, for every chunk, a wrapper that includes the scene and then the chunk's camera, and
+   renders them, opts->jobs at a time, each as soon as it is ready (opts->chunks_ready). On a POV-Ray failure stops the other processes, returns
+   L2P_FAILED and puts POV-Ray's own error lines (file, line, message) in err. */
+int povray_render_chunks(const povray_chunk *chunks, int count, const povray_options *opts,
+                         l2p_error *err);
+
+#endif

@@ -1,0 +1,29 @@
+/* POV-Ray's log: why a run failed, in POV-Ray's own words, and how far it has got. */
+#ifndef LENS2POV_POVRAY_LOG_H
+#define LENS2POV_POVRAY_LOG_H
+
+#include "base/error.h"
+
+typedef struct povray_path_link {
+    char *link, *target;       /* a symlink lens2pov made for POV-Ray, and the user's path */
+} povray_path_link;
+
+/* What a path in POV-Ray's messages stands for. */
+typedef struct povray_log_names {
+    const char *scene;         /* the user's scene */
+    const char *scene_dir;     /* POV-Ray's working folder: relative names are found there */
+    const char *own[2];        /* lens2pov's wrapper and camera include: an error there is the
+                                  scene's, left open, that POV-Ray noticed only reading on */
+    const povray_path_link *links;
+    int link_count;
+} povray_log_names;
+
+/* The reason in the log at log_path, as "FILE:LINE: message" in err (L2P_FAILED), with the
+   user's paths; 0 when the log gives none. */
+int povray_log_error(const char *log_path, const povray_log_names *names, l2p_error *err);
+
+/* The latest progress in the log: the parse (estimated from the chunk's face count) and the
+   render, each in [0, 1]; left as they were when the log says nothing new. */
+void povray_log_progress(const char *log_path, long long faces, double *parse, double *render);
+
+#endif

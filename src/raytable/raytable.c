@@ -1,0 +1,327 @@
+#include "raytable/raytable.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include "base/progress.h"
+
+long long raytable_faces_for_memory(double memory_mb)
+{
+    const double mb = memory_mb > 0 ? memory_mb : RAYTABLE_DEFAULT_MEMORY_MB;
+    const long long faces = (long long)(mb * 1048576.0 / RAYTABLE_POVRAY_BYTES_PER_FACE);
+    return faces > 0 ? faces : 1;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Rows of the film are traced and formatted by worker threads, one row each at a time, and
+   appended to the outputs in row order by the calling thread: the files are the same bytes
+   whatever the number of threads. */
+
+/* One traced and formatted row. */
+typedef struct row_out {
+    char *text;                /* the vertex text of the passed rays, one after the other */
+    size_t text_len, text_cap;
+    size_t *length;            /* of each passed ray's text */
+    unsigned char *kind;       /* and where its vertices are (POVMESH_SHARES_EDGE, ...) */
+    samplemap_record *record;
+    char *csv;                 /* their CSV rows, when asked for */
+    size_t csv_len, csv_cap, *csv_length;
+    long long samples, passed;
+} row_out;
+
+static int row_reserve(row_out *o, long long rays, bool csv)
+{
+    const size_t n = (size_t)rays;
+    o->text_cap = n * POVMESH_RAY_TEXT_MAX;
+    o->csv_cap = csv ? n * POVMESH_CSV_MAX : 0;
+    o->text = malloc(o->text_cap + 1);
+    o->length = malloc(n * sizeof *o->length + 1);
+    o->kind = malloc(n + 1);
+    o->record = malloc(n * sizeof *o->record + 1);
+    o->csv = malloc(o->csv_cap + 1);
+    o->csv_length = malloc(n * sizeof *o->csv_length + 1);
+    return o->text && o->length && o->kind && o->record && o->csv && o->csv_length ? 0 : -1;
+}
+
+static void row_free(row_out *o)
+{
+    free(o->text);
+    free(o->length);
+    free(o->kind);
+    free(o->record);
+    free(o->csv);
+    free(o->csv_length);
+}
+
+/* The samples of one film row, CAMERA_BATCH at a time, in pixel-then-sample order (the order
+   of the faces, whatever the batch size). */
+typedef struct batch {
+    int n;
+    emitted_ray r[CAMERA_BATCH];
+    vec3 film[CAMERA_BATCH];
+    double u[CAMERA_BATCH], v[CAMERA_BATCH], weight[CAMERA_BATCH];
+    ray out[CAMERA_BATCH];
+    bool passed[CAMERA_BATCH];
+} batch;
+
+/* Traces the batch and formats its passed rays into o; with no emitter, only counts them. */
+static void flush_batch(const camera *c, const povmesh_emitter *e, batch *b, row_out *o)
+{
+    camera_trace_batch(c, b->film, b->u, b->v, b->n, b->out, b->weight, b->passed);
+    o->samples += b->n;
+    if (!e) {
+        for (int k = 0; k < b->n; k++)
+            o->passed += b->passed[k];
+        b->n = 0;
+        return;
+    }
+    int n = 0;   /* the passed rays, moved to the front */
+    for (int k = 0; k < b->n; k++) {
+        if (!b->passed[k])
+            continue;
+        b->r[n] = b->r[k];
+        b->r[n].out = b->out[k];
+        b->r[n++].weight = b->weight[k];
+    }
+    const long long i = o->passed;
+    const bool csv = povmesh_wants_csv(e);
+    o->text_len += povmesh_format_rays(e, b->r, n, o->text + o->text_len, &o->length[i],
+                                       &o->kind[i], &o->record[i], csv ? o->csv + o->csv_len : NULL,
+                                       &o->csv_length[i]);
+    for (int k = 0; csv && k < n; k++)
+        o->csv_len += o->csv_length[i + k];
+    o->passed += n;
+    b->n = 0;
+}
+
+static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *b, row_out *o)
+{
+    o->text_len = o->csv_len = 0;
+    o->samples = o->passed = 0;
+    for (int px = c->crop_x0; px < c->crop_x1; px++) {
+        const sample_pixel pixel = sample_pattern_pixel(&c->samples, px, py);
+        for (int k = 0; k < c->samples.spp; k++) {
+            const film_sample s = sample_pattern_sample(&c->samples, pixel, k);
+            const vec3 film_point = film_camera_from_raster(&c->film, px + s.offset_x,
+                                                            py + s.offset_y);
+            if (!pupil_reaches(&c->pupil, film_point))
+                continue;   /* no ray from there gets through: not a sample to trace */
+            emitted_ray *r = &b->r[b->n];
+            r->px = px;
+            r->py = py;
+            r->offset_x = s.offset_x;
+            r->offset_y = s.offset_y;
+            r->film_point = b->film[b->n] = film_point;
+            b->u[b->n] = s.pupil_u;
+            b->v[b->n] = s.pupil_v;
+            if (++b->n == CAMERA_BATCH)
+                flush_batch(c, e, b, o);
+        }
+    }
+    flush_batch(c, e, b, o);
+}
+
+static int append_row(povmesh_emitter *e, const row_out *o, raytable_stats *stats, l2p_error *err)
+{
+    size_t at = 0, csv_at = 0;
+    for (long long i = 0; i < o->passed; i++) {
+        const size_t csv_len = povmesh_wants_csv(e) ? o->csv_length[i] : 0;
+        int st = povmesh_append(e, o->text + at, o->length[i], o->kind[i], &o->record[i],
+                                o->csv + csv_at, csv_len, err);
+        if (st)
+            return st;
+        at += o->length[i];
+        csv_at += csv_len;
+    }
+    stats->samples += o->samples;
+    stats->passed += o->passed;
+    return L2P_OK;
+}
+
+/* The workers and the writer share a ring of row slots: row py uses slot
+   (py - first_row) % slots, once the row before it in that slot is written. */
+typedef struct shared {
+    const camera *cam;
+    const povmesh_emitter *emitter;
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    int next_row, end_row, first_row, slots;
+    int written_row;           /* rows before it are written: their slots are free */
+    bool abort;
+    row_out *slot;
+    int *ready_row;            /* of each slot: the row whose results it holds, -1 at first */
+} shared;
+
+static void *worker(void *arg)
+{
+    shared *sh = arg;
+    batch *b = malloc(sizeof *b);
+    pthread_mutex_lock(&sh->lock);
+    while (b && !sh->abort && sh->next_row < sh->end_row) {
+        const int py = sh->next_row++, k = (py - sh->first_row) % sh->slots;
+        /* Row py takes slot k once row py - slots, its last user, is written; waiting only for
+           the slot to be free would let a later row take it first and deadlock. */
+        while (py >= sh->written_row + sh->slots && !sh->abort)
+            pthread_cond_wait(&sh->changed, &sh->lock);
+        if (sh->abort)
+            break;
+        pthread_mutex_unlock(&sh->lock);
+        b->n = 0;
+        trace_row(sh->cam, sh->emitter, py, b, &sh->slot[k]);
+        pthread_mutex_lock(&sh->lock);
+        sh->ready_row[k] = py;
+        pthread_cond_broadcast(&sh->changed);
+    }
+    if (!b)
+        sh->abort = true;   /* the writer sees a row that never comes and stops */
+    pthread_cond_broadcast(&sh->changed);
+    pthread_mutex_unlock(&sh->lock);
+    free(b);
+    return NULL;
+}
+
+/* The writer: rows in order as the workers finish them. */
+static int write_rows(shared *sh, povmesh_emitter *e, const atomic_bool *stop, progress *bar,
+                      raytable_stats *stats, l2p_error *err)
+{
+    int st = L2P_OK;
+    for (int py = sh->first_row; py < sh->end_row && !st; py++) {
+        if (stop && atomic_load(stop))
+            return l2p_fail(err, L2P_FAILED, NULL, 0, "stopped");
+        const int k = (py - sh->first_row) % sh->slots;
+        pthread_mutex_lock(&sh->lock);
+        while (sh->ready_row[k] != py && !sh->abort)
+            pthread_cond_wait(&sh->changed, &sh->lock);
+        const bool aborted = sh->abort;
+        pthread_mutex_unlock(&sh->lock);
+        if (aborted)
+            return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+        st = append_row(e, &sh->slot[k], stats, err);
+        pthread_mutex_lock(&sh->lock);
+        sh->written_row = py + 1;
+        pthread_cond_broadcast(&sh->changed);
+        pthread_mutex_unlock(&sh->lock);
+        progress_update(bar, (double)(py - sh->first_row + 1) / (sh->end_row - sh->first_row), NULL);
+    }
+    return st;
+}
+
+static int number_of_workers(void)
+{
+    const long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 16 ? 16 : (int)n;
+}
+
+static int trace_rows(const camera *c, povmesh_emitter *e, const atomic_bool *stop, progress *bar,
+                      raytable_stats *stats, l2p_error *err)
+{
+    const int workers = number_of_workers();
+    shared sh = {.cam = c, .emitter = e, .next_row = c->crop_y0, .end_row = c->crop_y1,
+                 .first_row = c->crop_y0, .written_row = c->crop_y0, .slots = 2 * workers};
+    sh.slot = calloc((size_t)sh.slots, sizeof *sh.slot);
+    sh.ready_row = malloc((size_t)sh.slots * sizeof *sh.ready_row);
+    const long long rays = (long long)(c->crop_x1 - c->crop_x0) * c->samples.spp;
+    int st = sh.slot && sh.ready_row ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < sh.slots && !st; k++)
+        sh.ready_row[k] = -1;
+    for (int k = 0; k < sh.slots && !st; k++)
+        if (row_reserve(&sh.slot[k], rays, povmesh_wants_csv(e)))
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    pthread_t thread[16];
+    int started = 0;
+    pthread_mutex_init(&sh.lock, NULL);
+    pthread_cond_init(&sh.changed, NULL);
+    while (!st && started < workers && pthread_create(&thread[started], NULL, worker, &sh) == 0)
+        started++;
+    if (!st && started == 0)
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
+    if (!st)
+        st = write_rows(&sh, e, stop, bar, stats, err);
+    pthread_mutex_lock(&sh.lock);
+    sh.abort = true;
+    pthread_cond_broadcast(&sh.changed);
+    pthread_mutex_unlock(&sh.lock);
+    for (int i = 0; i < started; i++)
+        pthread_join(thread[i], NULL);
+    for (int k = 0; sh.slot && k < sh.slots; k++)
+        row_free(&sh.slot[k]);
+    free(sh.slot);
+    free(sh.ready_row);
+    pthread_mutex_destroy(&sh.lock);
+    pthread_cond_destroy(&sh.changed);
+    return st;
+}
+
+int raytable_write(const camera *c, const char *prefix, const char *csv_path,
+                   long long chunk_faces, bool show_progress, const raytable_stream *stream,
+                   int *chunk_count, raytable_stats *stats, l2p_error *err)
+{
+    const double start = now_seconds();
+    raytable_stats local = {0, 0, 0};
+    povmesh_emitter *e;
+    int st = povmesh_open(&e, c, prefix, csv_path, chunk_faces, err);
+    if (st)
+        return st;
+    if (stream)
+        povmesh_set_chunk_hook(e, stream->chunk_done, stream->ctx);
+    progress bar;
+    progress_start(&bar, "tracing", show_progress);
+    st = trace_rows(c, e, stream ? stream->stop : NULL, &bar, &local, err);
+    progress_finish(&bar);
+    int close_st = povmesh_close(e, st == L2P_OK, chunk_count, err);
+    local.seconds = now_seconds() - start;
+    if (stats)
+        *stats = local;
+    return st ? st : close_st;
+}
+
+/* How many faces the table will have: every sample of the crop traced, none formatted. The
+   renderer cuts the table into chunks of equal face counts from it, so that the POV-Ray
+   processes parse equal shares (cutting by samples leaves the vignetted rows' chunks short). */
+typedef struct counter {
+    const camera *cam;
+    atomic_int next_row;
+    atomic_llong passed;
+} counter;
+
+static void *count_rows(void *arg)
+{
+    counter *t = arg;
+    batch *b = malloc(sizeof *b);
+    row_out o;
+    memset(&o, 0, sizeof o);
+    long long passed = 0;
+    for (int py; b && (py = atomic_fetch_add(&t->next_row, 1)) < t->cam->crop_y1;) {
+        b->n = 0;
+        trace_row(t->cam, NULL, py, b, &o);
+        passed += o.passed;
+    }
+    atomic_fetch_add(&t->passed, passed);
+    free(b);   /* without it this worker took no row: the others take them */
+    return NULL;
+}
+
+long long raytable_count_faces(const camera *c)
+{
+    counter t = {.cam = c};
+    atomic_init(&t.next_row, c->crop_y0);
+    atomic_init(&t.passed, 0);
+    const int helpers = number_of_workers() - 1;
+    pthread_t thread[16];
+    int started = 0;
+    while (started < helpers && pthread_create(&thread[started], NULL, count_rows, &t) == 0)
+        started++;
+    count_rows(&t);   /* this thread is the last worker, and works alone if none starts */
+    for (int i = 0; i < started; i++)
+        pthread_join(thread[i], NULL);
+    return atomic_load(&t.next_row) >= c->crop_y1 ? atomic_load(&t.passed) : -1;
+}

@@ -1,0 +1,44 @@
+/* Tracing every film sample of the crop into the ray table. */
+#ifndef LENS2POV_RAYTABLE_H
+#define LENS2POV_RAYTABLE_H
+
+#include <stdatomic.h>
+#include <stdbool.h>
+#include "camera/camera.h"
+#include "raytable/povmesh.h"
+
+typedef struct raytable_stats {
+    long long samples;   /* traced */
+    long long passed;    /* written: the rest the lens blocked */
+    double seconds;
+} raytable_stats;
+
+/* POV-Ray 3.7.0.10 needs about 210 bytes of memory per mesh_camera face of a mesh with
+   "hierarchy off", its output image included (measured: 744k faces, peak RSS 164 MB against
+   15 MB for an empty scene); the default budget is 1 GB a process. */
+#define RAYTABLE_POVRAY_BYTES_PER_FACE 215.0
+#define RAYTABLE_DEFAULT_MEMORY_MB 1024.0
+
+/* Faces per chunk for a POV-Ray memory budget in MB (<= 0: the default). */
+long long raytable_faces_for_memory(double memory_mb);
+
+/* The faces raytable_write will write for c: the samples of the crop the lens passes. Traces
+   them all on every core (about a fifth of the cost of writing them); -1 out of memory. */
+long long raytable_count_faces(const camera *c);
+
+/* For a renderer that starts on each chunk as it is complete: told of each chunk (see
+   povmesh_set_chunk_hook), and stopped between rows when *stop becomes true (L2P_FAILED). */
+typedef struct raytable_stream {
+    povmesh_chunk_hook chunk_done;
+    void *ctx;
+    const atomic_bool *stop;
+} raytable_stream;
+
+/* Traces crop pixels x spp samples and writes PREFIX.inc/.ini/.map (and csv_path when not
+   NULL); chunk_faces as for povmesh_open. Without a stream, all outputs appear together or
+   not at all. *chunk_count (when not NULL) gets the number of chunks. */
+int raytable_write(const camera *c, const char *prefix, const char *csv_path,
+                   long long chunk_faces, bool progress, const raytable_stream *stream,
+                   int *chunk_count, raytable_stats *stats, l2p_error *err);
+
+#endif
