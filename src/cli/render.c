@@ -10,11 +10,13 @@
 #include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "base/cores.h"
 #include "camera/camera.h"
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "base/outfile.h"
 #include "povray/povray.h"
+#include "raytable/chunk_name.h"
 #include "raytable/raytable.h"
 
 static int check_inputs(const cli *c, l2p_error *err)
@@ -36,12 +38,6 @@ static int check_inputs(const cli *c, l2p_error *err)
     if (!st && c->rays_csv)
         st = outfile_check_path(c->rays_csv, err);
     return st;
-}
-
-static int number_of_cores(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 ? (int)n : 1;
 }
 
 /* Chunks small enough for the memory budget, as many as a multiple of the jobs and with the
@@ -208,9 +204,9 @@ static povray_chunk *chunk_list(const writer *w, int count, long long faces)
 {
     povray_chunk *pc = calloc((size_t)count, sizeof *pc);
     for (int i = 0; pc && i < count; i++) {
-        char *inc = povmesh_chunk_file(w->prefix, true, i, "inc");
-        char *ini = povmesh_chunk_file(w->prefix, true, i, "ini");
-        char *exr = povmesh_chunk_file(w->prefix, true, i, "exr");
+        char *inc = chunk_file_name(w->prefix, i, "inc");
+        char *ini = chunk_file_name(w->prefix, i, "ini");
+        char *exr = chunk_file_name(w->prefix, i, "exr");
         pc[i] = (povray_chunk){inc, ini, exr, faces};
         if (!inc || !ini || !exr) {
             free_chunk_list(pc, i + 1);
@@ -299,7 +295,7 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         st = image_io_ready(err);
         /* Every process may use every core: the chunks cost the same to parse but not to shade
            (sky against floor), and a process left shading alone then gets the idle cores. */
-        const povray_options po = {c->positional[0], ws->dir, jobs, number_of_cores(),
+        const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
                                    !c->quiet, NULL, chunks_ready, &w};
         if (!st)
             st = povray_render_chunks(pc, count, &po, err);
@@ -335,7 +331,7 @@ int render_command(const cli *c, l2p_error *err)
     pthread_t loader;
     if (start_thread(&loader, load_image_library, NULL) == 0)
         pthread_detach(loader);   /* image_io_ready waits for it */
-    const int jobs = c->jobs > 0 ? c->jobs : number_of_cores();
+    const int jobs = c->jobs > 0 ? c->jobs : cores_online();
     workspace w;
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&

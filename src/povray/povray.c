@@ -17,8 +17,9 @@
 #include <time.h>
 #include <unistd.h>
 #include "base/outfile.h"
-#include "povray/povray_log.h"
 #include "base/progress.h"
+#include "povray/povray_log.h"
+#include "raytable/chunk_name.h"
 
 enum {
     TICK_MS = 20,
@@ -89,6 +90,7 @@ typedef struct run {
     const povray_options *opts;
     char *exe;
     char *work_dir;
+    char *chunk_prefix;        /* WORK/povray: the wrappers and logs are its chunk files */
     char *scene_real_dir;      /* the child's working folder */
     char *scene_for_povray, *scene_dir_for_povray;
     povray_path_link *links;
@@ -103,6 +105,7 @@ static void free_run(run *r)
 {
     free(r->exe);
     free(r->work_dir);
+    free(r->chunk_prefix);
     free(r->scene_real_dir);
     free(r->scene_for_povray);
     free(r->scene_dir_for_povray);
@@ -225,7 +228,8 @@ static int prepare_run(run *r, const povray_chunk *chunks, int count, const povr
         r->job_slots = count;
     r->jobs = calloc((size_t)r->job_slots, sizeof *r->jobs);
     r->work_dir = absolute_path(opts->work_dir);
-    if (!r->jobs || !r->work_dir)
+    r->chunk_prefix = r->work_dir ? str_printf("%s/povray", r->work_dir) : NULL;
+    if (!r->jobs || !r->chunk_prefix)
         return out_of_memory(err);
     int st = check_plain(r->work_dir, err);
     if (!st)
@@ -272,10 +276,10 @@ static int prepare_chunk(run *r, int index, chunk_args *a, l2p_error *err)
     const povray_chunk *c = &r->chunks[index];
     memset(a, 0, sizeof *a);
     char *include = absolute_path(c->include_path), *ini = absolute_path(c->ini_path);
-    char *inc_name = str_printf("povray.c%03d.inc", index);
-    char *ini_name = str_printf("povray.c%03d.ini", index);
+    char *inc_name = chunk_file_name("povray", index, "inc");
+    char *ini_name = chunk_file_name("povray", index, "ini");
     char *pov_inc = NULL;
-    a->wrapper = str_printf("%s/povray.c%03d.pov", r->work_dir, index);
+    a->wrapper = chunk_file_name(r->chunk_prefix, index, "pov");
     a->output = absolute_path(c->output_exr);
     int st = include && ini && inc_name && ini_name && a->wrapper && a->output
                  ? L2P_OK : out_of_memory(err);
@@ -398,7 +402,7 @@ static int start_job(run *r, job *j, int index, l2p_error *err)
     int st = prepare_chunk(r, index, &a, err);
     char **argv = st ? NULL : povray_argv(r, &a);
     free(j->log_path);
-    j->log_path = str_printf("%s/povray.c%03d.log", r->work_dir, index);
+    j->log_path = chunk_file_name(r->chunk_prefix, index, "log");
     if (!st && (!argv || !j->log_path))
         st = out_of_memory(err);
     const int fd = st ? -1 : open(j->log_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
@@ -457,7 +461,7 @@ static void stop_jobs(run *r)
 /* Why a job failed, in POV-Ray's own words when its log has them. */
 static int explain_failure(const run *r, const job *j, int status, l2p_error *err)
 {
-    char *wrapper = str_printf("%s/povray.c%03d.pov", r->work_dir, j->chunk);
+    char *wrapper = chunk_file_name(r->chunk_prefix, j->chunk, "pov");
     const povray_log_names names = {r->opts->scene_path, r->scene_real_dir,
                                     {wrapper, r->chunks[j->chunk].include_path},
                                     r->links, r->link_count};

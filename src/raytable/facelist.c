@@ -1,23 +1,25 @@
 #include "raytable/facelist.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-int face_list_add(face_list *f, enum face_code code)
+int face_list_add(face_list *f, unsigned kind)
 {
+    const unsigned stored = kind & (FACE_SWAPPED | FACE_SHARES_EDGE);
     const size_t byte = (size_t)(f->faces >> 2);
     if (byte >= f->cap) {
         const size_t cap = f->cap ? 2 * f->cap : 4096;
-        uint8_t *grown = realloc(f->codes, cap);
+        uint8_t *grown = realloc(f->kinds, cap);
         if (!grown)
             return -1;
         memset(grown + f->cap, 0, cap - f->cap);
-        f->codes = grown;
+        f->kinds = grown;
         f->cap = cap;
     }
-    f->codes[byte] |= (uint8_t)(code << (2 * (f->faces & 3)));
+    f->kinds[byte] |= (uint8_t)(stored << (2 * (f->faces & 3)));
     f->faces++;
-    f->vertices += code >= FACE_SHARED ? 1 : 3;
+    f->vertices += stored & FACE_SHARES_EDGE ? 1 : 3;
     return 0;
 }
 
@@ -45,14 +47,13 @@ int face_list_write(const face_list *f, text_out *t, l2p_error *err)
         if ((st = text_reserve(t, 4096 * 72, err)) != 0)
             return st;
         for (; done < end; done++) {
-            const int code = f->codes[done >> 2] >> (2 * (done & 3)) & 3;
-            if (code == FACE_OWN || code == FACE_OWN_SWAPPED) {
-                const uint64_t first = code == FACE_OWN ? n : n + 1;
-                put_triple(t, first, first == n ? n + 1 : n, n + 2);
+            const unsigned kind = f->kinds[done >> 2] >> (2 * (done & 3)) & 3;
+            const bool swapped = kind & FACE_SWAPPED;
+            if (!(kind & FACE_SHARES_EDGE)) {
+                put_triple(t, swapped ? n + 1 : n, swapped ? n : n + 1, n + 2);
                 n += 3;
             } else {
-                const uint64_t first = code == FACE_SHARED ? n - 3 : n - 2;
-                put_triple(t, first, first == n - 3 ? n - 2 : n - 3, n);
+                put_triple(t, swapped ? n - 2 : n - 3, swapped ? n - 3 : n - 2, n);
                 n += 1;
             }
         }
@@ -62,7 +63,7 @@ int face_list_write(const face_list *f, text_out *t, l2p_error *err)
 
 void face_list_free(face_list *f)
 {
-    free(f->codes);
-    f->codes = NULL;
+    free(f->kinds);
+    f->kinds = NULL;
     f->cap = 0;
 }

@@ -7,22 +7,22 @@
 #include <stdint.h>
 #include "base/textout.h"
 
-/* With n vertices written before the face: */
-enum face_code {
-    FACE_OWN = 0,           /* <n, n+1, n+2>, three vertices of its own */
-    FACE_OWN_SWAPPED = 1,   /* <n+1, n, n+2> */
-    FACE_SHARED = 2,        /* <n-3, n-2, n>, the edge of the face before and one of its own */
-    FACE_SHARED_SWAPPED = 3 /* <n-2, n-3, n> */
+/* Where a face's vertices lie among the n written before it, as bits. A face of its own is
+   <n, n+1, n+2>; one that shares the edge of the face before is <n-3, n-2, n>. */
+enum face_kind {
+    FACE_SWAPPED = 1,       /* its first two vertices in the other order */
+    FACE_SHARES_EDGE = 2,   /* the edge of the face before, and one vertex of its own */
+    FACE_GIVES_EDGE = 4     /* the next face shares its first two vertices (not stored) */
 };
 
 typedef struct face_list {
-    uint8_t *codes;         /* four faces a byte */
+    uint8_t *kinds;         /* FACE_SWAPPED | FACE_SHARES_EDGE, four faces a byte */
     size_t cap;
     long long faces, vertices;
 } face_list;
 
-/* Adds a face; -1 out of memory. */
-int face_list_add(face_list *f, enum face_code code);
+/* Adds a face of the given kind; -1 out of memory. */
+int face_list_add(face_list *f, unsigned kind);
 
 /* "face_indices { N," and the faces' index triples. */
 int face_list_write(const face_list *f, text_out *t, l2p_error *err);

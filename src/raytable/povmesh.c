@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "raytable/chunk_name.h"
 #include "raytable/facelist.h"
 #include "base/outfile.h"
 #include "raytable/povface.h"
@@ -57,14 +58,12 @@ static void put_number(text_out *t, const povmesh_emitter *e, double v)
 
 char *povmesh_chunk_file(const char *prefix, bool chunked, int index, const char *ext)
 {
-    size_t n = strlen(prefix) + 32;
+    if (chunked)
+        return chunk_file_name(prefix, index, ext);
+    const size_t n = strlen(prefix) + strlen(ext) + 2;
     char *p = malloc(n);
-    if (!p)
-        return NULL;
-    if (!chunked)
+    if (p)
         snprintf(p, n, "%s.%s", prefix, ext);
-    else
-        snprintf(p, n, "%s.c%03d.%s", prefix, index, ext);
     return p;
 }
 
@@ -138,10 +137,10 @@ static int put_faces_of(const povmesh_emitter *e, const emitted_ray *r, int i, i
             for (int k = 0; k < 3; k++)
                 put_vertex(t, e, v[k]);
             len[i] = t->len - start;
-            kind[i] = (unsigned char)(POVMESH_GIVES_EDGE | (swap[0] ? POVMESH_SWAPPED : 0));
+            kind[i] = (unsigned char)(FACE_GIVES_EDGE | (swap[0] ? FACE_SWAPPED : 0));
             put_vertex(t, e, v[3]);
             len[i + 1] = t->len - start - len[i];
-            kind[i + 1] = (unsigned char)(POVMESH_SHARES_EDGE | (swap[1] ? POVMESH_SWAPPED : 0));
+            kind[i + 1] = (unsigned char)(FACE_SHARES_EDGE | (swap[1] ? FACE_SWAPPED : 0));
             return 2;
         }
     }
@@ -206,7 +205,7 @@ static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)
         return st;
     if (ch->faces.faces == 0) {   /* nothing passed the lens: one zero-area face, a ray to nowhere */
         text_put_str(t, "<0,0,0>,<0,0,0>,<0,0,0>,\n");
-        if (face_list_add(&ch->faces, FACE_OWN))
+        if (face_list_add(&ch->faces, 0))
             return l2p_fail(err, L2P_FAILED, t->file.final_path, 0, "out of memory");
     }
     text_put_str(t, "  }\n");
@@ -361,11 +360,11 @@ size_t povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n
 static int put_face(povmesh_emitter *e, chunk *ch, const char *text, size_t len, unsigned kind,
                     l2p_error *err)
 {
-    const bool shares = kind & POVMESH_SHARES_EDGE, alone = shares && ch->faces.faces == 0;
+    const bool shares = kind & FACE_SHARES_EDGE, alone = shares && ch->faces.faces == 0;
     int st = text_reserve(&ch->inc, len + (alone ? e->edge_len : 0), err);
     if (st)
         return st;
-    if (kind & POVMESH_GIVES_EDGE) {   /* its first two lines are the edge */
+    if (kind & FACE_GIVES_EDGE) {   /* its first two lines are the edge */
         const char *end = memchr(text, '\n', len);
         end = end ? memchr(end + 1, '\n', len - (size_t)(end + 1 - text)) : NULL;
         e->edge_len = end ? (size_t)(end + 1 - text) : 0;
@@ -374,9 +373,8 @@ static int put_face(povmesh_emitter *e, chunk *ch, const char *text, size_t len,
     if (alone)
         text_put(&ch->inc, e->edge_text, e->edge_len);
     text_put(&ch->inc, text, len);
-    const int swapped = kind & POVMESH_SWAPPED ? 1 : 0;
-    const enum face_code code = shares && !alone ? FACE_SHARED + swapped : FACE_OWN + swapped;
-    if (face_list_add(&ch->faces, code))
+    /* A face whose edge went with the chunk before has its vertices of its own. */
+    if (face_list_add(&ch->faces, alone ? kind & ~(unsigned)FACE_SHARES_EDGE : kind))
         return l2p_fail(err, L2P_FAILED, ch->inc.file.final_path, 0, "out of memory");
     return L2P_OK;
 }

@@ -37,12 +37,7 @@ int povmesh_open(povmesh_emitter **e, const camera *c, const char *prefix, const
 
    Neighbouring rays share a triangle edge where float32 can hold them as well as alone (see
    povface.h): four vertices for two faces, which POV-Ray parses in two thirds of the time.
-   A face's kind tells the appender where its vertices are. */
-enum {
-    POVMESH_SWAPPED = 1,      /* the face lists its first two vertices in the other order */
-    POVMESH_SHARES_EDGE = 2,  /* its first two vertices are those of the face before */
-    POVMESH_GIVES_EDGE = 4    /* the next face shares its first two vertices */
-};
+   A face's kind (enum face_kind, facelist.h) tells the appender where its vertices are. */
 enum { POVMESH_RAY_TEXT_MAX = 512, POVMESH_CSV_MAX = 512 };
 
 /* Formats n rays, consecutive faces, into text (at most n * POVMESH_RAY_TEXT_MAX bytes;

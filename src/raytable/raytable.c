@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "base/cores.h"
 #include "base/progress.h"
 
 long long raytable_faces_for_memory(double memory_mb)
@@ -31,7 +32,7 @@ typedef struct row_out {
     char *text;                /* the vertex text of the passed rays, one after the other */
     size_t text_len, text_cap;
     size_t *length;            /* of each passed ray's text */
-    unsigned char *kind;       /* and where its vertices are (POVMESH_SHARES_EDGE, ...) */
+    unsigned char *kind;       /* and where its vertices are (enum face_kind) */
     samplemap_record *record;
     char *csv;                 /* their CSV rows, when asked for */
     size_t csv_len, csv_cap, *csv_length;
@@ -215,10 +216,12 @@ static int write_rows(shared *sh, povmesh_emitter *e, const atomic_bool *stop, p
     return st;
 }
 
+enum { MAX_WORKERS = 16 };
+
 static int number_of_workers(void)
 {
-    const long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n < 1 ? 1 : n > 16 ? 16 : (int)n;
+    const int n = cores_online();
+    return n < MAX_WORKERS ? n : MAX_WORKERS;
 }
 
 static int trace_rows(const camera *c, povmesh_emitter *e, const atomic_bool *stop, progress *bar,
@@ -236,7 +239,7 @@ static int trace_rows(const camera *c, povmesh_emitter *e, const atomic_bool *st
     for (int k = 0; k < sh.slots && !st; k++)
         if (row_reserve(&sh.slot[k], rays, povmesh_wants_csv(e)))
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    pthread_t thread[16];
+    pthread_t thread[MAX_WORKERS];
     int started = 0;
     pthread_mutex_init(&sh.lock, NULL);
     pthread_cond_init(&sh.changed, NULL);
@@ -316,7 +319,7 @@ long long raytable_count_faces(const camera *c)
     atomic_init(&t.next_row, c->crop_y0);
     atomic_init(&t.passed, 0);
     const int helpers = number_of_workers() - 1;
-    pthread_t thread[16];
+    pthread_t thread[MAX_WORKERS];
     int started = 0;
     while (started < helpers && pthread_create(&thread[started], NULL, count_rows, &t) == 0)
         started++;
