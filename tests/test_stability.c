@@ -422,19 +422,20 @@ static void check_rays(const stab_case *sc, const camera *cam, const csv_ray *ro
         const int row_samples = (cam->crop_x1 - cam->crop_x0) * cam->samples.spp;
         for (int b = 0; b < row_samples; b += CAMERA_BATCH) {
             const int m = row_samples - b < CAMERA_BATCH ? row_samples - b : CAMERA_BATCH;
-            vec3 film[CAMERA_BATCH];
-            double u[CAMERA_BATCH], v[CAMERA_BATCH], w[CAMERA_BATCH];
-            ray out[CAMERA_BATCH];
-            bool passed[CAMERA_BATCH];
+            sample_batch batch = {.n = m};
+            vec3 *film = batch.film_point;
+            const double *u = batch.u, *v = batch.v, *w = batch.weight;
+            const ray *out = batch.out;
+            const bool *passed = batch.passed;
             for (int k = 0; k < m; k++) {
                 const int px = cam->crop_x0 + (b + k) / cam->samples.spp;
                 const film_sample fs = sample_pattern_get(&cam->samples, px, py,
                                                           (b + k) % cam->samples.spp);
                 film[k] = film_camera_from_raster(&cam->film, px + fs.offset_x, py + fs.offset_y);
-                u[k] = fs.pupil_u;
-                v[k] = fs.pupil_v;
+                batch.u[k] = fs.pupil_u;
+                batch.v[k] = fs.pupil_v;
             }
-            camera_trace_batch(cam, film, u, v, m, out, w, passed);
+            camera_trace_batch(cam, &batch);
                 for (int k = 0; k < m; k++) {
                     res->samples++;
                     /* The same film ray, traced one at a time in double and in long double. */

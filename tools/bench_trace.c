@@ -57,10 +57,7 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
     if (make_camera(&c, lens_path, p, t, 256, 192, 16))
         return;
     double rate[5], passed_fraction = 0;
-    vec3 fp[CAMERA_BATCH];
-    double u[CAMERA_BATCH], v[CAMERA_BATCH], w[CAMERA_BATCH];
-    ray r[CAMERA_BATCH];
-    bool ok[CAMERA_BATCH];
+    sample_batch batch;
     for (int run = 0; run < 5; run++) {
         long long n = 0, passed = 0;
         int b = 0;
@@ -70,16 +67,18 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
                 const sample_pixel pixel = sample_pattern_pixel(&c.samples, px, py);
                 for (int k = 0; k < c.samples.spp; k++) {
                     film_sample s = sample_pattern_sample(&c.samples, pixel, k);
-                    fp[b] = film_camera_from_raster(&c.film, px + s.offset_x, py + s.offset_y);
-                    if (!pupil_reaches(&c.pupil, fp[b]))
+                    batch.film_point[b] = film_camera_from_raster(&c.film, px + s.offset_x,
+                                                                  py + s.offset_y);
+                    if (!pupil_reaches(&c.pupil, batch.film_point[b]))
                         continue;   /* as the ray table does: not a sample */
-                    u[b] = s.pupil_u;
-                    v[b] = s.pupil_v;
+                    batch.u[b] = s.pupil_u;
+                    batch.v[b] = s.pupil_v;
                     if (++b < CAMERA_BATCH)
                         continue;
-                    camera_trace_batch(&c, fp, u, v, b, r, w, ok);
+                    batch.n = b;
+                    camera_trace_batch(&c, &batch);
                     for (int j = 0; j < b; j++)
-                        passed += ok[j];
+                        passed += batch.passed[j];
                     n += b;
                     b = 0;
                 }
@@ -135,24 +134,23 @@ static void bench_pupil(const char *lens_path, double f_number)
         per_sample[run] = (now() - start) / (50.0 * N);
     }
     long long n = 0, passed = 0, cn = 0, cpassed = 0;
-    ray r[CAMERA_BATCH];
-    bool ok[CAMERA_BATCH];
+    sample_batch batch;
     for (int py = 0; py < c.film.height; py++)
         for (int px = 0; px < c.film.width; px += CAMERA_BATCH / 16) {
-            vec3 f[CAMERA_BATCH];
-            double su[CAMERA_BATCH], sv[CAMERA_BATCH], sw[CAMERA_BATCH];
             int b = 0;
             for (int k = 0; k < CAMERA_BATCH; k++) {
                 const sample_pixel pixel = sample_pattern_pixel(&c.samples, px + k / 16, py);
                 const film_sample s = sample_pattern_sample(&c.samples, pixel, k % 16);
-                f[b] = film_camera_from_raster(&c.film, px + k / 16 + s.offset_x, py + s.offset_y);
-                su[b] = s.pupil_u;
-                sv[b] = s.pupil_v;
-                b += pupil_reaches(&c.pupil, f[b]);
+                batch.film_point[b] = film_camera_from_raster(&c.film, px + k / 16 + s.offset_x,
+                                                              py + s.offset_y);
+                batch.u[b] = s.pupil_u;
+                batch.v[b] = s.pupil_v;
+                b += pupil_reaches(&c.pupil, batch.film_point[b]);
             }
-            camera_trace_batch(&c, f, su, sv, b, r, sw, ok);
+            batch.n = b;
+            camera_trace_batch(&c, &batch);
             for (int k = 0; k < b; k++)
-                passed += ok[k];
+                passed += batch.passed[k];
             n += b;
         }
     for (int k = 0; k < 65536; k++) {   /* jittered strata: a regular grid misses the rim */
@@ -180,10 +178,11 @@ static void bench_write(const char *lens_path, const char *dir)
     snprintf(prefix, sizeof prefix, "%s/bench", dir);
     snprintf(inc, sizeof inc, "%s.inc", prefix);
     double t[5];
-    raytable_stats st = {0, 0, 0};
+    raytable_stats st = {0, 0, 0, 0};
+    const raytable_request q = {prefix, NULL, 0, false, NULL};
     for (int run = 0; run < 5; run++) {
         l2p_error err;
-        if (raytable_write(&c, prefix, NULL, 0, false, NULL, NULL, &st, &err)) {
+        if (raytable_write(&c, &q, &st, &err)) {
             fprintf(stderr, "bench: %s\n", err.text);
             return;
         }

@@ -41,11 +41,16 @@ static int setup_placement(camera *c, const camera_options *o, l2p_error *err)
     return L2P_OK;
 }
 
-vec3 camera_world_from_camera_point(const camera *c, vec3 p)
+vec3 camera_world_from_camera_offset(const camera *c, vec3 p)
 {
     const vec3 m = v3_add(v3_add(v3_scale(c->right, p.x), v3_scale(c->up, p.y)),
                           v3_scale(c->forward, p.z));
-    return v3_add(c->location, v3_scale(m, 1.0 / c->unit_mm));
+    return v3_scale(m, 1.0 / c->unit_mm);
+}
+
+vec3 camera_world_from_camera_point(const camera *c, vec3 p)
+{
+    return v3_add(c->location, camera_world_from_camera_offset(c, p));
 }
 
 vec3 camera_world_from_camera_dir(const camera *c, vec3 d)
@@ -278,37 +283,44 @@ static void rays_from_soa(ray *r, const trace_soa *b, int n)
     }
 }
 
-void camera_trace_batch(const camera *c, const vec3 *film_points, const double *u,
-                        const double *v, int n, ray *out, double *weight, bool *passed)
+void camera_trace_batch(const camera *c, sample_batch *s)
 {
+    const int n = s->n;
     trace_soa b;
     vec3 direction[CAMERA_BATCH];
-    pupil_film_rays(&c->pupil, n, film_points, u, v, direction, weight);
+    pupil_film_rays(&c->pupil, n, s->film_point, s->u, s->v, direction, s->weight);
     for (int k = 0; k < n; k++) {
-        weight[k] *= c->weight_scale;
-        b.status[k] = weight[k] > 0.0 && isfinite(weight[k]) && v3_isfinite(direction[k])
+        s->weight[k] *= c->weight_scale;
+        b.status[k] = s->weight[k] > 0.0 && isfinite(s->weight[k]) && v3_isfinite(direction[k])
                           ? TRACE_PASSED : TRACE_MISSED;
     }
     if (c->trace == TRACE_KIND_THICK) {
         for (int k = 0; k < n; k++) {
-            out[k].o = film_points[k];
-            out[k].d = direction[k];
-            if (b.status[k] == TRACE_PASSED && !trace_thick(c, &out[k]))
+            s->out[k].o = s->film_point[k];
+            s->out[k].d = direction[k];
+            if (b.status[k] == TRACE_PASSED && !trace_thick(c, &s->out[k]))
                 b.status[k] = TRACE_MISSED;
         }
     } else {
-        soa_from_rays(&b, film_points, direction, n);
+        soa_from_rays(&b, s->film_point, direction, n);
         trace_soa_toward_scene(&c->lens, &b, n);
-        rays_from_soa(out, &b, n);
+        rays_from_soa(s->out, &b, n);
     }
     /* & rather than &&: whether a ray passed is unpredictable, a branch on it costly. */
     for (int k = 0; k < n; k++)
-        passed[k] = (b.status[k] == TRACE_PASSED) & v3_isfinite(out[k].o) & v3_isfinite(out[k].d);
+        s->passed[k] = (b.status[k] == TRACE_PASSED) & v3_isfinite(s->out[k].o) &
+                       v3_isfinite(s->out[k].d);
 }
 
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight)
 {
-    bool passed;
-    camera_trace_batch(c, &film_point, &u, &v, 1, out, weight, &passed);
-    return passed;
+    sample_batch s;
+    s.n = 1;
+    s.film_point[0] = film_point;
+    s.u[0] = u;
+    s.v[0] = v;
+    camera_trace_batch(c, &s);
+    *out = s.out[0];
+    *weight = s.weight[0];
+    return s.passed[0];
 }

@@ -61,12 +61,24 @@ void camera_free(camera *c);
    weight, and returns true; false when the lens blocks it. */
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight);
 
-/* The same for n <= CAMERA_BATCH samples at once, interleaved for speed. */
+/* Film samples traced together, interleaved for speed: in, each one's film point and pupil
+   sample; out, its ray, its weight and whether the lens passed it. */
 enum { CAMERA_BATCH = TRACE_SOA_MAX };   /* one call of the batch tracer */
-void camera_trace_batch(const camera *c, const vec3 *film_points, const double *u,
-                        const double *v, int n, ray *out, double *weight, bool *passed);
+typedef struct sample_batch {
+    int n;                                  /* <= CAMERA_BATCH */
+    vec3 film_point[CAMERA_BATCH];
+    double u[CAMERA_BATCH], v[CAMERA_BATCH];
+    ray out[CAMERA_BATCH];
+    double weight[CAMERA_BATCH];
+    bool passed[CAMERA_BATCH];
+} sample_batch;
 
+void camera_trace_batch(const camera *c, sample_batch *b);
+
+/* Camera space (mm) to world (scene units): a point; a difference of points (the rotation and
+   the scale without the translation); a direction, normalized. */
 vec3 camera_world_from_camera_point(const camera *c, vec3 p);
+vec3 camera_world_from_camera_offset(const camera *c, vec3 p);
 vec3 camera_world_from_camera_dir(const camera *c, vec3 d);
 
 

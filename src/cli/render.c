@@ -156,15 +156,16 @@ static void *write_table(void *arg)
 {
     writer *w = arg;
     l2p_error err;
-    int count = 0;
     const raytable_stream stream = {chunk_done, w, &w->stop};
-    const int st = raytable_write(w->cam, w->prefix, w->c->rays_csv ? w->csv : NULL,
-                                  w->chunk_faces, !w->c->quiet, &stream, &count, NULL, &err);
+    const raytable_request q = {w->prefix, w->c->rays_csv ? w->csv : NULL, w->chunk_faces,
+                                !w->c->quiet, &stream};
+    raytable_stats stats;
+    const int st = raytable_write(w->cam, &q, &stats, &err);
     pthread_mutex_lock(&w->lock);
     w->status = st;
     if (st)
         w->err = err;
-    w->total = st ? w->ready : count;
+    w->total = st ? w->ready : stats.chunks;
     pthread_mutex_unlock(&w->lock);
     return NULL;
 }

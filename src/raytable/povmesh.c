@@ -116,11 +116,8 @@ static void put_vertex(text_out *t, const povmesh_emitter *e, vec3 v)
 /* A ray in the mesh's frame: scene units, world axes, relative to the anchor. */
 static ray mesh_ray(const povmesh_emitter *e, const ray *r)
 {
-    const camera *c = e->cam;
-    const vec3 rel = v3_sub(r->o, e->anchor_camera_mm);
-    const vec3 o = v3_scale(v3_add(v3_add(v3_scale(c->right, rel.x), v3_scale(c->up, rel.y)),
-                                   v3_scale(c->forward, rel.z)), 1.0 / c->unit_mm);
-    return (ray){o, camera_world_from_camera_dir(c, r->d)};
+    const vec3 o = camera_world_from_camera_offset(e->cam, v3_sub(r->o, e->anchor_camera_mm));
+    return (ray){o, camera_world_from_camera_dir(e->cam, r->d)};
 }
 
 /* Formats face i alone, or faces i and i + 1 on a shared edge; returns the faces done. */
@@ -155,7 +152,7 @@ static int put_faces_of(const povmesh_emitter *e, const emitted_ray *r, int i, i
 
 /* The camera: the mesh moved to the lens with a double-precision translate. The mesh is never
    intersected, so it gets no bounding-box tree: "hierarchy off" cuts POV-Ray's parse of the
-   table by about a third and its memory by a quarter (measured: 8.2 against 5.1 us a face). */
+   table by about a third and its memory by a quarter (docs/povray.md). */
 static void put_camera(text_out *t, const povmesh_emitter *e)
 {
     const vec3 w = camera_world_from_camera_point(e->cam, e->anchor_camera_mm);
@@ -335,24 +332,24 @@ static size_t put_csv(char *csv, const emitted_ray *r)
         r->out.o.x, r->out.o.y, r->out.o.z, r->out.d.x, r->out.d.y, r->out.d.z, r->weight);
 }
 
-size_t povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n, char *text,
-                           size_t *len, unsigned char *kind, samplemap_record *rec, char *csv,
-                           size_t *csv_len)
+void povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n,
+                         formatted_faces *f)
 {
-    text_out t = {.buf = text, .len = 0};
+    text_out t = {.buf = f->text, .len = f->text_len};
+    size_t *len = f->length + f->count;
+    unsigned char *kind = f->kind + f->count;
     for (int i = 0; i < n;)
         i += put_faces_of(e, r, i, n, &t, len, kind);
-    for (int i = 0; i < n; i++) {
-        rec[i] = (samplemap_record){(uint32_t)r[i].py * (uint32_t)e->cam->film.width +
-                                        (uint32_t)r[i].px,
-                                    (float)r[i].offset_x, (float)r[i].offset_y,
-                                    (float)r[i].weight};
-        if (csv) {
-            csv_len[i] = put_csv(csv, &r[i]);
-            csv += csv_len[i];
+    f->text_len = t.len;
+    for (int i = 0; i < n; i++, f->count++) {
+        f->record[f->count] = (samplemap_record){
+            (uint32_t)r[i].py * (uint32_t)e->cam->film.width + (uint32_t)r[i].px,
+            (float)r[i].offset_x, (float)r[i].offset_y, (float)r[i].weight};
+        if (e->has_csv) {
+            f->csv_length[f->count] = put_csv(f->csv + f->csv_len, &r[i]);
+            f->csv_len += f->csv_length[f->count];
         }
     }
-    return t.len;
 }
 
 /* The vertex text of one face, and its code. A face that shares the edge of a face left in
@@ -379,8 +376,9 @@ static int put_face(povmesh_emitter *e, chunk *ch, const char *text, size_t len,
     return L2P_OK;
 }
 
-int povmesh_append(povmesh_emitter *e, const char *text, size_t len, unsigned kind,
-                   const samplemap_record *rec, const char *csv, size_t csv_len, l2p_error *err)
+static int append_face(povmesh_emitter *e, const char *text, size_t len, unsigned kind,
+                       const samplemap_record *rec, const char *csv, size_t csv_len,
+                       l2p_error *err)
 {
     int st;
     chunk *ch = &e->chunks[e->chunk_count - 1];
@@ -399,6 +397,21 @@ int povmesh_append(povmesh_emitter *e, const char *text, size_t len, unsigned ki
     if ((st = text_reserve(&e->csv, csv_len, err)) != 0)
         return st;
     text_put(&e->csv, csv, csv_len);
+    return L2P_OK;
+}
+
+int povmesh_append(povmesh_emitter *e, const formatted_faces *f, l2p_error *err)
+{
+    size_t at = 0, csv_at = 0;
+    for (long long i = 0; i < f->count; i++) {
+        const size_t csv_len = e->has_csv ? f->csv_length[i] : 0;
+        int st = append_face(e, f->text + at, f->length[i], f->kind[i], &f->record[i],
+                             f->csv + csv_at, csv_len, err);
+        if (st)
+            return st;
+        at += f->length[i];
+        csv_at += csv_len;
+    }
     return L2P_OK;
 }
 

@@ -40,16 +40,25 @@ int povmesh_open(povmesh_emitter **e, const camera *c, const char *prefix, const
    A face's kind (enum face_kind, facelist.h) tells the appender where its vertices are. */
 enum { POVMESH_RAY_TEXT_MAX = 512, POVMESH_CSV_MAX = 512 };
 
-/* Formats n rays, consecutive faces, into text (at most n * POVMESH_RAY_TEXT_MAX bytes;
-   returns its length): len[i] bytes and kind[i] for face i, its sample-map record and, when
-   csv is not NULL, its CSV row (at most POVMESH_CSV_MAX bytes, csv_len[i]). */
-size_t povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n, char *text,
-                           size_t *len, unsigned char *kind, samplemap_record *rec, char *csv,
-                           size_t *csv_len);
+/* Faces formatted and not yet appended, in face order: each one's vertex text (one after the
+   other), its kind, its sample-map record and, when the emitter writes CSV, its CSV row. */
+typedef struct formatted_faces {
+    char *text;
+    size_t text_len, *length;
+    unsigned char *kind;
+    samplemap_record *record;
+    char *csv;
+    size_t csv_len, *csv_length;
+    long long count;
+} formatted_faces;
 
-/* Appends one face formatted above; faces come in order. */
-int povmesh_append(povmesh_emitter *e, const char *text, size_t len, unsigned kind,
-                   const samplemap_record *rec, const char *csv, size_t csv_len, l2p_error *err);
+/* Formats n rays, consecutive faces, onto the end of f, which has room for them (n more
+   entries, n * POVMESH_RAY_TEXT_MAX text bytes, n * POVMESH_CSV_MAX CSV bytes). */
+void povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n,
+                         formatted_faces *f);
+
+/* Appends f's faces, in order. */
+int povmesh_append(povmesh_emitter *e, const formatted_faces *f, l2p_error *err);
 bool povmesh_wants_csv(const povmesh_emitter *e);
 
 /* Called as each chunk is complete, with its files already renamed into place (not with the

@@ -29,85 +29,66 @@ static double now_seconds(void)
 
 /* One traced and formatted row. */
 typedef struct row_out {
-    char *text;                /* the vertex text of the passed rays, one after the other */
-    size_t text_len, text_cap;
-    size_t *length;            /* of each passed ray's text */
-    unsigned char *kind;       /* and where its vertices are (enum face_kind) */
-    samplemap_record *record;
-    char *csv;                 /* their CSV rows, when asked for */
-    size_t csv_len, csv_cap, *csv_length;
-    long long samples, passed;
+    formatted_faces faces;     /* the passed rays */
+    long long samples;
 } row_out;
 
 static int row_reserve(row_out *o, long long rays, bool csv)
 {
     const size_t n = (size_t)rays;
-    o->text_cap = n * POVMESH_RAY_TEXT_MAX;
-    o->csv_cap = csv ? n * POVMESH_CSV_MAX : 0;
-    o->text = malloc(o->text_cap + 1);
-    o->length = malloc(n * sizeof *o->length + 1);
-    o->kind = malloc(n + 1);
-    o->record = malloc(n * sizeof *o->record + 1);
-    o->csv = malloc(o->csv_cap + 1);
-    o->csv_length = malloc(n * sizeof *o->csv_length + 1);
-    return o->text && o->length && o->kind && o->record && o->csv && o->csv_length ? 0 : -1;
+    formatted_faces *f = &o->faces;
+    f->text = malloc(n * POVMESH_RAY_TEXT_MAX + 1);
+    f->length = malloc(n * sizeof *f->length + 1);
+    f->kind = malloc(n + 1);
+    f->record = malloc(n * sizeof *f->record + 1);
+    f->csv = malloc((csv ? n * POVMESH_CSV_MAX : 0) + 1);
+    f->csv_length = malloc(n * sizeof *f->csv_length + 1);
+    return f->text && f->length && f->kind && f->record && f->csv && f->csv_length ? 0 : -1;
 }
 
 static void row_free(row_out *o)
 {
-    free(o->text);
-    free(o->length);
-    free(o->kind);
-    free(o->record);
-    free(o->csv);
-    free(o->csv_length);
+    formatted_faces *f = &o->faces;
+    free(f->text);
+    free(f->length);
+    free(f->kind);
+    free(f->record);
+    free(f->csv);
+    free(f->csv_length);
 }
 
 /* The samples of one film row, CAMERA_BATCH at a time, in pixel-then-sample order (the order
    of the faces, whatever the batch size). */
 typedef struct batch {
-    int n;
+    sample_batch s;
     emitted_ray r[CAMERA_BATCH];
-    vec3 film[CAMERA_BATCH];
-    double u[CAMERA_BATCH], v[CAMERA_BATCH], weight[CAMERA_BATCH];
-    ray out[CAMERA_BATCH];
-    bool passed[CAMERA_BATCH];
 } batch;
 
 /* Traces the batch and formats its passed rays into o; with no emitter, only counts them. */
 static void flush_batch(const camera *c, const povmesh_emitter *e, batch *b, row_out *o)
 {
-    camera_trace_batch(c, b->film, b->u, b->v, b->n, b->out, b->weight, b->passed);
-    o->samples += b->n;
-    if (!e) {
-        for (int k = 0; k < b->n; k++)
-            o->passed += b->passed[k];
-        b->n = 0;
-        return;
-    }
+    sample_batch *s = &b->s;
+    camera_trace_batch(c, s);
+    o->samples += s->n;
     int n = 0;   /* the passed rays, moved to the front */
-    for (int k = 0; k < b->n; k++) {
-        if (!b->passed[k])
+    for (int k = 0; k < s->n; k++) {
+        if (!s->passed[k])
             continue;
         b->r[n] = b->r[k];
-        b->r[n].out = b->out[k];
-        b->r[n++].weight = b->weight[k];
+        b->r[n].out = s->out[k];
+        b->r[n++].weight = s->weight[k];
     }
-    const long long i = o->passed;
-    const bool csv = povmesh_wants_csv(e);
-    o->text_len += povmesh_format_rays(e, b->r, n, o->text + o->text_len, &o->length[i],
-                                       &o->kind[i], &o->record[i], csv ? o->csv + o->csv_len : NULL,
-                                       &o->csv_length[i]);
-    for (int k = 0; csv && k < n; k++)
-        o->csv_len += o->csv_length[i + k];
-    o->passed += n;
-    b->n = 0;
+    if (e)
+        povmesh_format_rays(e, b->r, n, &o->faces);
+    else
+        o->faces.count += n;
+    s->n = 0;
 }
 
 static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *b, row_out *o)
 {
-    o->text_len = o->csv_len = 0;
-    o->samples = o->passed = 0;
+    o->faces.text_len = o->faces.csv_len = 0;
+    o->faces.count = o->samples = 0;
     for (int px = c->crop_x0; px < c->crop_x1; px++) {
         const sample_pixel pixel = sample_pattern_pixel(&c->samples, px, py);
         for (int k = 0; k < c->samples.spp; k++) {
@@ -116,15 +97,13 @@ static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *
                                                             py + s.offset_y);
             if (!pupil_reaches(&c->pupil, film_point))
                 continue;   /* no ray from there gets through: not a sample to trace */
-            emitted_ray *r = &b->r[b->n];
-            r->px = px;
-            r->py = py;
-            r->offset_x = s.offset_x;
-            r->offset_y = s.offset_y;
-            r->film_point = b->film[b->n] = film_point;
-            b->u[b->n] = s.pupil_u;
-            b->v[b->n] = s.pupil_v;
-            if (++b->n == CAMERA_BATCH)
+            const int k = b->s.n;
+            b->r[k] = (emitted_ray){.px = px, .py = py, .offset_x = s.offset_x,
+                                    .offset_y = s.offset_y, .film_point = film_point};
+            b->s.film_point[k] = film_point;
+            b->s.u[k] = s.pupil_u;
+            b->s.v[k] = s.pupil_v;
+            if (++b->s.n == CAMERA_BATCH)
                 flush_batch(c, e, b, o);
         }
     }
@@ -133,19 +112,9 @@ static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *
 
 static int append_row(povmesh_emitter *e, const row_out *o, raytable_stats *stats, l2p_error *err)
 {
-    size_t at = 0, csv_at = 0;
-    for (long long i = 0; i < o->passed; i++) {
-        const size_t csv_len = povmesh_wants_csv(e) ? o->csv_length[i] : 0;
-        int st = povmesh_append(e, o->text + at, o->length[i], o->kind[i], &o->record[i],
-                                o->csv + csv_at, csv_len, err);
-        if (st)
-            return st;
-        at += o->length[i];
-        csv_at += csv_len;
-    }
     stats->samples += o->samples;
-    stats->passed += o->passed;
-    return L2P_OK;
+    stats->passed += o->faces.count;
+    return povmesh_append(e, &o->faces, err);
 }
 
 /* The workers and the writer share a ring of row slots: row py uses slot
@@ -176,7 +145,7 @@ static void *worker(void *arg)
         if (sh->abort)
             break;
         pthread_mutex_unlock(&sh->lock);
-        b->n = 0;
+        b->s.n = 0;
         trace_row(sh->cam, sh->emitter, py, b, &sh->slot[k]);
         pthread_mutex_lock(&sh->lock);
         sh->ready_row[k] = py;
@@ -264,23 +233,22 @@ static int trace_rows(const camera *c, povmesh_emitter *e, const atomic_bool *st
     return st;
 }
 
-int raytable_write(const camera *c, const char *prefix, const char *csv_path,
-                   long long chunk_faces, bool show_progress, const raytable_stream *stream,
-                   int *chunk_count, raytable_stats *stats, l2p_error *err)
+int raytable_write(const camera *c, const raytable_request *q, raytable_stats *stats,
+                   l2p_error *err)
 {
     const double start = now_seconds();
-    raytable_stats local = {0, 0, 0};
+    raytable_stats local = {0, 0, 0, 0};
     povmesh_emitter *e;
-    int st = povmesh_open(&e, c, prefix, csv_path, chunk_faces, err);
+    int st = povmesh_open(&e, c, q->prefix, q->csv_path, q->chunk_faces, err);
     if (st)
         return st;
-    if (stream)
-        povmesh_set_chunk_hook(e, stream->chunk_done, stream->ctx);
+    if (q->stream)
+        povmesh_set_chunk_hook(e, q->stream->chunk_done, q->stream->ctx);
     progress bar;
-    progress_start(&bar, "tracing", show_progress);
-    st = trace_rows(c, e, stream ? stream->stop : NULL, &bar, &local, err);
+    progress_start(&bar, "tracing", q->progress);
+    st = trace_rows(c, e, q->stream ? q->stream->stop : NULL, &bar, &local, err);
     progress_finish(&bar);
-    int close_st = povmesh_close(e, st == L2P_OK, chunk_count, err);
+    int close_st = povmesh_close(e, st == L2P_OK, &local.chunks, err);
     local.seconds = now_seconds() - start;
     if (stats)
         *stats = local;
@@ -304,9 +272,9 @@ static void *count_rows(void *arg)
     memset(&o, 0, sizeof o);
     long long passed = 0;
     for (int py; b && (py = atomic_fetch_add(&t->next_row, 1)) < t->cam->crop_y1;) {
-        b->n = 0;
+        b->s.n = 0;
         trace_row(t->cam, NULL, py, b, &o);
-        passed += o.passed;
+        passed += o.faces.count;
     }
     atomic_fetch_add(&t->passed, passed);
     free(b);   /* without it this worker took no row: the others take them */

@@ -10,6 +10,7 @@
 typedef struct raytable_stats {
     long long samples;   /* traced */
     long long passed;    /* written: the rest the lens blocked */
+    int chunks;          /* written */
     double seconds;
 } raytable_stats;
 
@@ -34,11 +35,18 @@ typedef struct raytable_stream {
     const atomic_bool *stop;
 } raytable_stream;
 
-/* Traces crop pixels x spp samples and writes PREFIX.inc/.ini/.map (and csv_path when not
-   NULL); chunk_faces as for povmesh_open. Without a stream, all outputs appear together or
-   not at all. *chunk_count (when not NULL) gets the number of chunks. */
-int raytable_write(const camera *c, const char *prefix, const char *csv_path,
-                   long long chunk_faces, bool progress, const raytable_stream *stream,
-                   int *chunk_count, raytable_stats *stats, l2p_error *err);
+/* What to write, and where. */
+typedef struct raytable_request {
+    const char *prefix;             /* PREFIX.inc, PREFIX.ini, PREFIX.map */
+    const char *csv_path;           /* every ray as CSV; NULL: none */
+    long long chunk_faces;          /* as for povmesh_open: 0 is one chunk */
+    bool progress;                  /* a bar on stderr */
+    const raytable_stream *stream;  /* NULL: none */
+} raytable_request;
+
+/* Traces crop pixels x spp samples and writes the table. Without a stream, all outputs appear
+   together or not at all. stats may be NULL. */
+int raytable_write(const camera *c, const raytable_request *q, raytable_stats *stats,
+                   l2p_error *err);
 
 #endif
