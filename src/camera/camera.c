@@ -226,6 +226,10 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
     int st = setup_film(c, o, err);
     if (!st)
         st = setup_placement(c, o, err);
+    /* The cardinal points are probed, and the focus found, by rays at a fixed fraction of the
+       smallest opening, the stop's included: the opening is chosen with the full stop's focal
+       length, and the points that the camera keeps are found again at the chosen opening and
+       film distance. */
     if (!st)
         st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->whole, err);
     if (!st)
