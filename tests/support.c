@@ -1,25 +1,24 @@
+/* nftw is X/Open. */
+#define _XOPEN_SOURCE 700
+
 #include "support.h"
 
 #include <criterion/criterion.h>
+#include <dirent.h>
+#include <errno.h>
 #include <fcntl.h>
+#include <ftw.h>
 #include <spawn.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 extern char **environ;
-
-const char *test_tmpdir(void)
-{
-    static char dir[64];
-    snprintf(dir, sizeof dir, "/tmp/l2ptest.XXXXXX");
-    cr_assert_not_null(mkdtemp(dir));
-    return dir;
-}
 
 const char *tmp_path(const char *dir, const char *name)
 {
@@ -36,6 +35,100 @@ void write_text(const char *path, const char *text)
     cr_assert_not_null(f, "cannot write %s", path);
     fwrite(text, 1, strlen(text), f);
     fclose(f);
+}
+
+void write_bytes(const char *path, const char *data, size_t length)
+{
+    FILE *f = fopen(path, "wb");
+    cr_assert_not_null(f, "cannot write %s: %s", path, strerror(errno));
+    cr_assert_eq(fwrite(data, 1, length, f), length, "cannot write %s", path);
+    cr_assert_eq(fclose(f), 0, "cannot write %s", path);
+}
+
+bool file_exists(const char *path)
+{
+    struct stat st;
+    return lstat(path, &st) == 0;
+}
+
+static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st;
+    (void)flag;
+    (void)ftw;
+    return remove(path);
+}
+
+void remove_tree(const char *dir)
+{
+    cr_assert(strncmp(dir, "/tmp/", 5) == 0 && !strstr(dir, ".."), "not a test folder: %s", dir);
+    cr_expect_eq(nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS), 0, "cannot remove %s: %s",
+                 dir, strerror(errno));
+}
+
+/* Every test's folders go in one folder of the run, made before the first test (the tests'
+   processes inherit its name) and removed after the last unless a test failed, so that a
+   failure leaves its files to look at. Criterion ends a test's process without running
+   atexit handlers, so the tests cannot clean up after themselves. */
+static char run_dir[32];
+
+ReportHook(PRE_ALL)(struct criterion_test_set *set)
+{
+    (void)set;
+    snprintf(run_dir, sizeof run_dir, "/tmp/l2ptest.XXXXXX");
+    if (mkdtemp(run_dir))
+        setenv("LENS2POV_TEST_DIR", run_dir, 1);
+}
+
+ReportHook(POST_ALL)(struct criterion_global_stats *stats)
+{
+    if (run_dir[0] && stats->tests_failed == 0 && stats->tests_crashed == 0)
+        nftw(run_dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+    else if (run_dir[0])
+        fprintf(stderr, "the tests' files are kept in %s\n", run_dir);
+}
+
+const char *test_tmpdir(void)
+{
+    static char dir[64];
+    const char *root = getenv("LENS2POV_TEST_DIR");
+    snprintf(dir, sizeof dir, "%s/t.XXXXXX", root ? root : "/tmp");
+    cr_assert_not_null(mkdtemp(dir), "mkdtemp %s: %s", dir, strerror(errno));
+    return dir;
+}
+
+int count_entries(const char *dir, const char *prefix, char *listing, size_t size)
+{
+    DIR *d = opendir(dir);
+    cr_assert_not_null(d, "cannot list %s", dir);
+    int n = 0;
+    if (listing && size)
+        listing[0] = '\0';
+    for (struct dirent *e; (e = readdir(d)) != NULL;) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        if (prefix && strncmp(e->d_name, prefix, strlen(prefix)))
+            continue;
+        n++;
+        if (listing) {
+            const size_t len = strlen(listing);
+            snprintf(listing + len, size - len, "%s ", e->d_name);
+        }
+    }
+    closedir(d);
+    return n;
+}
+
+void test_camera(camera *c, const char *lens_name, const camera_options *o)
+{
+    char path[512];
+    snprintf(path, sizeof path, LENS_DIR "%s.dat", lens_name);
+    lens l;
+    l2p_error err;
+    cr_assert_eq(lens_read(path, &l, &err), 0, "%s", err.text);
+    camera_options defaults;
+    camera_options_default(&defaults);
+    cr_assert_eq(camera_setup(c, &l, o ? o : &defaults, &err), 0, "%s: %s", lens_name, err.text);
 }
 
 char *read_text(const char *path, size_t *length)

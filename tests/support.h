@@ -2,8 +2,10 @@
 #ifndef LENS2POV_TEST_SUPPORT_H
 #define LENS2POV_TEST_SUPPORT_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include "base/vec3.h"
+#include "camera/camera.h"
 
 #ifndef LENS2POV_SOURCE_DIR
 #define LENS2POV_SOURCE_DIR "."
@@ -15,13 +17,29 @@
    Returns the exit status. */
 int run_lens2pov(char **out, char **errout, ...);
 
-/* A fresh temporary folder under /tmp, and a path inside it (static buffers rotate). */
+/* A fresh folder under /tmp, removed with everything in it when the test's process exits
+   (the name is in a buffer the next call reuses), and a path inside a folder (static buffers
+   rotate). */
 const char *test_tmpdir(void);
 const char *tmp_path(const char *dir, const char *name);
 
-/* Writes text to path (exact bytes). */
+/* Writes text, or length bytes, to path (exact bytes); reads a whole file (malloc'd, with a
+   NUL after it; NULL when it cannot be read). */
 void write_text(const char *path, const char *text);
+void write_bytes(const char *path, const char *data, size_t length);
 char *read_text(const char *path, size_t *length);
+
+bool file_exists(const char *path);
+
+/* Removes a folder under /tmp with everything in it. */
+void remove_tree(const char *dir);
+
+/* The entries of a folder (without . and ..) whose names start with prefix (NULL: all);
+   listing, when not NULL, gets their names, space-separated. */
+int count_entries(const char *dir, const char *prefix, char *listing, size_t size);
+
+/* A camera of lenses/NAME.dat with options o (NULL: the defaults); fails the test on error. */
+void test_camera(camera *c, const char *lens_name, const camera_options *o);
 
 /* One row of the --rays CSV. */
 typedef struct csv_ray {

@@ -12,64 +12,7 @@
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "image/samplemap.h"
-
-/* ---- helpers (static: other test files have their own) ---- */
-
-static char test_dir[64];
-
-/* Removes the test's folder and what is in it (one level: the tests make no deeper trees). */
-static void remove_test_dir(void)
-{
-    DIR *d = opendir(test_dir);
-    if (!d)
-        return;
-    char path[512];
-    for (struct dirent *e; (e = readdir(d)) != NULL;)
-        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-            snprintf(path, sizeof path, "%s/%s", test_dir, e->d_name);
-            remove(path);
-        }
-    closedir(d);
-    rmdir(test_dir);
-}
-
-/* A fresh folder for this test, removed when the test's process exits (pass or fail). */
-static const char *new_dir(void)
-{
-    snprintf(test_dir, sizeof test_dir, "/tmp/l2pdev.XXXXXX");
-    cr_assert_not_null(mkdtemp(test_dir));
-    atexit(remove_test_dir);
-    return test_dir;
-}
-
-static const char *in_dir(const char *dir, const char *name)
-{
-    static char buf[4][512];
-    static int next;
-    char *p = buf[next++ % 4];
-    snprintf(p, 512, "%s/%s", dir, name);
-    return p;
-}
-
-static int file_exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0;
-}
-
-/* Number of entries of a folder (without . and ..); names starting with prefix when not NULL. */
-static int count_entries(const char *dir, const char *prefix)
-{
-    DIR *d = opendir(dir);
-    cr_assert_not_null(d);
-    int n = 0;
-    for (struct dirent *e; (e = readdir(d)) != NULL;)
-        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..") &&
-            (!prefix || strncmp(e->d_name, prefix, strlen(prefix)) == 0))
-            n++;
-    closedir(d);
-    return n;
-}
+#include "support.h"
 
 static double srgb_decode(double v)
 {
@@ -272,7 +215,7 @@ Test(develop, wrong_render_size_refused)
    picture as EXR with its metadata. */
 Test(develop, files_end_to_end)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     samplemap m;
     make_map(&m);
     char paths[3][512];
@@ -291,7 +234,7 @@ Test(develop, files_end_to_end)
         free(px);
         free(rgb);
     }
-    const char *out = in_dir(dir, "picture.exr");
+    const char *out = tmp_path(dir, "picture.exr");
     cr_assert_eq(develop_files(&m, renders, 3, out, &err), L2P_OK, "%s", err.text);
     int w, h;
     float *got, want[3 * CW * CH];
@@ -333,12 +276,12 @@ Test(develop, missing_render_names_file)
     samplemap m;
     make_map(&m);
     m.header.faces = 3;   /* one chunk */
-    const char *dir = new_dir();
-    const char *renders[1] = {in_dir(dir, "missing.exr")};
+    const char *dir = test_tmpdir();
+    const char *renders[1] = {tmp_path(dir, "missing.exr")};
     l2p_error err = {0, ""};
-    cr_assert_eq(develop_files(&m, renders, 1, in_dir(dir, "out.png"), &err), L2P_BAD_INPUT);
+    cr_assert_eq(develop_files(&m, renders, 1, tmp_path(dir, "out.png"), &err), L2P_BAD_INPUT);
     cr_assert(strstr(err.text, "missing.exr"), "%s", err.text);
-    cr_assert_eq(count_entries(dir, NULL), 0);
+    cr_assert_eq(count_entries(dir, NULL, NULL, 0), 0);
     samplemap_free(&m);
 }
 
@@ -359,7 +302,7 @@ static const char *write_test_map(const char *dir)
 {
     samplemap m;
     make_map(&m);
-    const char *path = in_dir(dir, "rays.map");
+    const char *path = tmp_path(dir, "rays.map");
     write_map_file(path, &m.header, m.records, FACES);
     samplemap_free(&m);
     return path;
@@ -367,7 +310,7 @@ static const char *write_test_map(const char *dir)
 
 Test(samplemap, round_trip_exact)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     samplemap m;
     make_map(&m);
     /* values whose bits must survive: tiny, huge, just below 1, a newline in the lens name */
@@ -378,7 +321,7 @@ Test(samplemap, round_trip_exact)
     snprintf(m.header.lens, sizeof m.header.lens, "Tessar\nf/3.5\r!");
     m.header.focus_distance_units = INFINITY;
     m.header.f_number = 0.1;
-    const char *path = in_dir(dir, "rays.map");
+    const char *path = tmp_path(dir, "rays.map");
     write_map_file(path, &m.header, m.records, FACES);
     struct stat st;
     cr_assert_eq(stat(path, &st), 0);
@@ -410,12 +353,12 @@ Test(samplemap, round_trip_exact)
 /* The on-disk bytes are little-endian whatever the machine, and the header is text. */
 Test(samplemap, file_layout)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     samplemap_header h;
     fill_header(&h);
     h.faces = 1;
     const samplemap_record rec = {0x01020304u, 0.5f, 0.25f, 1.0f};
-    const char *path = in_dir(dir, "one.map");
+    const char *path = tmp_path(dir, "one.map");
     write_map_file(path, &h, &rec, 1);
     FILE *fp = fopen(path, "rb");
     unsigned char buf[SAMPLEMAP_HEADER_BYTES + 16];
@@ -433,12 +376,12 @@ Test(samplemap, file_layout)
 
 Test(samplemap, empty_table)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     samplemap_header h;
     fill_header(&h);
     h.faces = 0;
     h.chunk_faces = PW;
-    const char *path = in_dir(dir, "empty.map");
+    const char *path = tmp_path(dir, "empty.map");
     write_map_file(path, &h, NULL, 0);
     samplemap r;
     l2p_error err = {0, ""};
@@ -450,10 +393,10 @@ Test(samplemap, empty_table)
 
 Test(samplemap, finish_checks_record_count)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     samplemap m;
     make_map(&m);
-    FILE *fp = fopen(in_dir(dir, "short.map"), "wb");
+    FILE *fp = fopen(tmp_path(dir, "short.map"), "wb");
     cr_assert_eq(samplemap_begin(fp), L2P_OK);
     cr_assert_eq(samplemap_append(fp, m.records, FACES - 1), L2P_OK);
     cr_assert_eq(samplemap_finish(fp, &m.header), L2P_FAILED);
@@ -473,7 +416,7 @@ static void expect_refused(const char *path, const char *fragment)
 
 Test(samplemap, truncated_refused)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     const char *path = write_test_map(dir);
     cr_assert_eq(truncate(path, SAMPLEMAP_HEADER_BYTES + 16 * FACES - 5), 0);
     expect_refused(path, "truncated");
@@ -485,7 +428,7 @@ Test(samplemap, truncated_refused)
 
 Test(samplemap, trailing_bytes_refused)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     const char *path = write_test_map(dir);
     FILE *fp = fopen(path, "ab");
     fputc(0, fp);
@@ -504,13 +447,13 @@ static void patch(const char *path, long offset, const char *bytes)
 
 Test(samplemap, wrong_magic_refused)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     const char *path = write_test_map(dir);
     patch(path, 0, "lens2pov-samplemap 2");
     expect_refused(path, "not a lens2pov sample map");
     patch(path, 0, "LENS2POV");
     expect_refused(path, "not a lens2pov sample map");
-    expect_refused(in_dir(dir, "absent.map"), "No such file");
+    expect_refused(tmp_path(dir, "absent.map"), "No such file");
 }
 
 /* A header written by hand: every key, one at a time, replaced by a bad line. */
@@ -534,7 +477,7 @@ static const char *hand_map(const char *dir, const char *replace_key, const char
     strcat(text, "end\n");
     memset(text + strlen(text), ' ', SAMPLEMAP_HEADER_BYTES - strlen(text));
     text[SAMPLEMAP_HEADER_BYTES] = '\0';
-    const char *path = in_dir(dir, "hand.map");
+    const char *path = tmp_path(dir, "hand.map");
     FILE *fp = fopen(path, "wb");
     fwrite(text, 1, SAMPLEMAP_HEADER_BYTES, fp);
     const unsigned char rec[16] = {2 + 7, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x80, 0x3f};
@@ -545,7 +488,7 @@ static const char *hand_map(const char *dir, const char *replace_key, const char
 
 Test(samplemap, hand_written_header)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     samplemap r;
     l2p_error err = {0, ""};
     cr_assert_eq(samplemap_read(hand_map(dir, NULL, NULL), &r, &err), L2P_OK, "%s", err.text);
@@ -561,7 +504,7 @@ Test(samplemap, hand_written_header)
 
 Test(samplemap, bad_headers_refused)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     expect_refused(hand_map(dir, "spp", ""), "no 'spp'");
     expect_refused(hand_map(dir, "spp", "spp 2\nspp 2"), "twice");
     expect_refused(hand_map(dir, "spp", "spp two"), "bad value for spp");
@@ -582,14 +525,14 @@ static const char *map_with_record(const char *dir, samplemap_record rec)
     samplemap_header h;
     fill_header(&h);
     h.faces = 1;
-    const char *path = in_dir(dir, "rec.map");
+    const char *path = tmp_path(dir, "rec.map");
     write_map_file(path, &h, &rec, 1);
     return path;
 }
 
 Test(samplemap, bad_records_refused)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     typedef samplemap_record rec;
     const uint32_t inside = CY0 * FW + CX0;
     expect_refused(map_with_record(dir, (rec){inside - 1, 0, 0, 1}), "outside the crop");
@@ -617,8 +560,8 @@ static void fill_rgb(float *rgb, int n, float value)
 
 Test(image_io, exr_round_trip)
 {
-    const char *dir = new_dir();
-    const char *path = in_dir(dir, "a.exr");
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "a.exr");
     const float rgb[3 * 6] = {0.123456789f, 1.0f, 0.0f, 3.75f, 1e-3f, 250.0f,
                               0.5f, 0.25f, 0.2f, 1e-2f, 7.0f, 0.999f,
                               2.0f, 0.3f, 0.4f, 0.6f, 0.7f, 0.8f};
@@ -640,8 +583,8 @@ Test(image_io, exr_round_trip)
 /* Linear 0.5 is stored as sRGB code 188 (0.7354 * 255 = 187.5), read back as its decoding. */
 Test(image_io, png_srgb_encoding)
 {
-    const char *dir = new_dir();
-    const char *path = in_dir(dir, "a.PNG");   /* the extension is matched case-insensitively */
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "a.PNG");   /* the extension is matched case-insensitively */
     const float rgb[3 * 2] = {0.5f, 0.0f, 1.0f, 2.0f, -1.0f, 0.002f};
     l2p_error err = {0, ""};
     cr_assert_eq(image_write_rgb(path, 2, 1, rgb, NULL, 0, &err), L2P_OK, "%s", err.text);
@@ -661,8 +604,8 @@ Test(image_io, png_srgb_encoding)
 
 Test(image_io, tiff_16bit_round_trip)
 {
-    const char *dir = new_dir();
-    const char *path = in_dir(dir, "a.tiff");
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "a.tiff");
     float rgb[3 * 4];
     fill_rgb(rgb, 4, 0.5f);
     rgb[4] = 0.01f;
@@ -685,8 +628,8 @@ Test(image_io, tiff_16bit_round_trip)
 
 Test(image_io, png_metadata)
 {
-    const char *dir = new_dir();
-    const char *path = in_dir(dir, "m.png");
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "m.png");
     float rgb[3];
     fill_rgb(rgb, 1, 0.25f);
     const image_attribute attrs[] = {{"lens2pov:lens", "Wide\nangle"}, {"Software", "lens2pov"},
@@ -703,7 +646,7 @@ Test(image_io, png_metadata)
     cr_assert_eq(image_get_attribute(path, "FNumber", value, sizeof value), L2P_OK);
     cr_assert_float_eq(atof(value), 2.8, 1e-6);
     cr_assert_eq(image_get_attribute(path, "lens2pov:absent", value, sizeof value), L2P_FAILED);
-    cr_assert_eq(image_get_attribute(in_dir(dir, "none.png"), "x", value, sizeof value),
+    cr_assert_eq(image_get_attribute(tmp_path(dir, "none.png"), "x", value, sizeof value),
                  L2P_FAILED);
     /* truncation to the buffer */
     char small[5];
@@ -713,59 +656,59 @@ Test(image_io, png_metadata)
 
 Test(image_io, unknown_extension_refused)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     float rgb[3] = {0};
     l2p_error err = {0, ""};
-    const char *path = in_dir(dir, "a.xyz");
+    const char *path = tmp_path(dir, "a.xyz");
     cr_assert_eq(image_write_rgb(path, 1, 1, rgb, NULL, 0, &err), L2P_BAD_INPUT);
     cr_assert(strstr(err.text, path), "%s", err.text);
     cr_assert(strstr(err.text, "unknown image type '.xyz' (use .png, .exr or .tif)"), "%s",
               err.text);
-    cr_assert_eq(image_write_rgb(in_dir(dir, "noext"), 1, 1, rgb, NULL, 0, &err), L2P_BAD_INPUT);
-    cr_assert_eq(image_write_rgb(in_dir(dir, "a.png.d/x"), 1, 1, rgb, NULL, 0, &err),
+    cr_assert_eq(image_write_rgb(tmp_path(dir, "noext"), 1, 1, rgb, NULL, 0, &err), L2P_BAD_INPUT);
+    cr_assert_eq(image_write_rgb(tmp_path(dir, "a.png.d/x"), 1, 1, rgb, NULL, 0, &err),
                  L2P_BAD_INPUT);
-    cr_assert_eq(count_entries(dir, NULL), 0);
+    cr_assert_eq(count_entries(dir, NULL, NULL, 0), 0);
 }
 
 Test(image_io, missing_folder_fails_cleanly)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     float rgb[3] = {0};
     l2p_error err = {0, ""};
-    const char *path = in_dir(dir, "no/such/folder/a.png");
+    const char *path = tmp_path(dir, "no/such/folder/a.png");
     const int st = image_write_rgb(path, 1, 1, rgb, NULL, 0, &err);
     cr_assert_neq(st, L2P_OK);
     cr_assert_eq(st, L2P_BAD_INPUT, "%s", err.text);
     cr_assert(strstr(err.text, path), "%s", err.text);
-    cr_assert_eq(count_entries(dir, NULL), 0);
+    cr_assert_eq(count_entries(dir, NULL, NULL, 0), 0);
 }
 
 /* A write that fails at the rename (the final name is a folder) leaves no temporary file. */
 Test(image_io, failed_write_leaves_nothing)
 {
-    const char *dir = new_dir();
-    const char *path = in_dir(dir, "taken.exr");
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "taken.exr");
     cr_assert_eq(mkdir(path, 0755), 0);
     float rgb[3] = {0.5f, 0.5f, 0.5f};
     l2p_error err = {0, ""};
     cr_assert_eq(image_write_rgb(path, 1, 1, rgb, NULL, 0, &err), L2P_FAILED);
     cr_assert(strstr(err.text, path), "%s", err.text);
-    cr_assert_eq(count_entries(dir, NULL), 1);
+    cr_assert_eq(count_entries(dir, NULL, NULL, 0), 1);
     rmdir(path);
 }
 
 Test(image_io, atomic_write_leaves_no_temp)
 {
-    const char *dir = new_dir();
-    const char *path = in_dir(dir, "pic.png");
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "pic.png");
     float rgb[3 * 4];
     fill_rgb(rgb, 4, 0.25f);
     l2p_error err = {0, ""};
     cr_assert_eq(image_write_rgb(path, 2, 2, rgb, NULL, 0, &err), L2P_OK, "%s", err.text);
     fill_rgb(rgb, 4, 1.0f);   /* overwriting replaces the file */
     cr_assert_eq(image_write_rgb(path, 2, 2, rgb, NULL, 0, &err), L2P_OK, "%s", err.text);
-    cr_assert_eq(count_entries(dir, NULL), 1);
-    cr_assert_eq(count_entries(dir, "."), 0);
+    cr_assert_eq(count_entries(dir, NULL, NULL, 0), 1);
+    cr_assert_eq(count_entries(dir, ".", NULL, 0), 0);
     cr_assert(file_exists(path));
     int w, h;
     float *px;
@@ -776,14 +719,14 @@ Test(image_io, atomic_write_leaves_no_temp)
 
 Test(image_io, read_errors)
 {
-    const char *dir = new_dir();
+    const char *dir = test_tmpdir();
     int w, h;
     float *px = NULL;
     l2p_error err = {0, ""};
-    const char *missing = in_dir(dir, "missing.exr");
+    const char *missing = tmp_path(dir, "missing.exr");
     cr_assert_eq(image_read_rgba(missing, &w, &h, &px, &err), L2P_BAD_INPUT);
     cr_assert(strstr(err.text, missing), "%s", err.text);
-    const char *junk = in_dir(dir, "junk.exr");
+    const char *junk = tmp_path(dir, "junk.exr");
     FILE *fp = fopen(junk, "wb");
     fputs("not an image\n", fp);
     fclose(fp);
@@ -796,8 +739,8 @@ Test(image_io, read_errors)
 /* A one-channel 8-bit file (PGM) is grey with alpha 1, sRGB-decoded. */
 Test(image_io, grey_file_read_as_rgba)
 {
-    const char *dir = new_dir();
-    const char *path = in_dir(dir, "g.pgm");
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "g.pgm");
     FILE *fp = fopen(path, "wb");
     fputs("P5\n3 1\n255\n", fp);
     fputc(0, fp);

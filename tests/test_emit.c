@@ -51,16 +51,11 @@ Test(emit, include_reproduces_the_traced_rays)
 
 static void camera_for(const char *lens_name, const char *pupil, camera *c)
 {
-    char path[512];
-    snprintf(path, sizeof path, LENS_DIR "%s.dat", lens_name);
-    lens l;
-    l2p_error err;
-    cr_assert_eq(lens_read(path, &l, &err), 0, "%s", err.text);
     camera_options o;
     camera_options_default(&o);
     o.look_at = v3(0, 0, 3);
     pupil_kind_parse(pupil, &o.pupil);
-    cr_assert_eq(camera_setup(c, &l, &o, &err), 0, "%s", err.text);
+    test_camera(c, lens_name, &o);
 }
 
 Test(emit, rays_traced_back_land_on_their_film_points)

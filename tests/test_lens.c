@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "optics/lens.h"
+#include "support.h"
 
 /* ---- helpers ---------------------------------------------------------------------------- */
 
@@ -75,14 +76,6 @@ static void temp_dir(char dir[64])
 {
     strcpy(dir, "/tmp/lens_test_XXXXXX");
     cr_assert_not_null(mkdtemp(dir), "mkdtemp: %s", strerror(errno));
-}
-
-static void write_file(const char *path, const char *text, size_t length)
-{
-    FILE *f = fopen(path, "wb");
-    cr_assert_not_null(f, "fopen %s: %s", path, strerror(errno));
-    cr_assert_eq(fwrite(text, 1, length, f), length);
-    cr_assert_eq(fclose(f), 0);
 }
 
 /* ---- rows that are not four numbers ----------------------------------------------------- */
@@ -436,7 +429,7 @@ Test(lens, read_file)
     temp_dir(dir);
     snprintf(path, sizeof path, "%s/my.lens.dat", dir);
     const char text[] = "# test\r\n" FRONT STOP "-10 5 1 8";
-    write_file(path, text, sizeof text - 1);
+    write_bytes(path, text, sizeof text - 1);
     lens l;
     l2p_error err = {0};
     cr_assert_eq(lens_read(path, &l, &err), L2P_OK, "%s", err.text);

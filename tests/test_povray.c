@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "povray/povray.h"
+#include "support.h"
 
 /* ---------------------------------------------------------------- files */
 
@@ -23,30 +24,6 @@ static char *fmt(const char *f, const char *a, const char *b)
     char *s = malloc(4096);
     snprintf(s, 4096, f, a, b);
     return s;
-}
-
-static void put_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    cr_assert_not_null(f, "cannot write %s", path);
-    fputs(text, f);
-    fclose(f);
-}
-
-static char *new_dir(void)
-{
-    char *d = strdup("/tmp/l2p_povray.XXXXXX");
-    cr_assert_not_null(mkdtemp(d));
-    return d;
-}
-
-/* Removes a folder made by new_dir, with everything in it, and frees its name. */
-static void remove_dir(char *dir)
-{
-    char cmd[256];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    cr_expect_eq(system(cmd), 0);
-    free(dir);
 }
 
 /* A 4x2 ray table, every ray from z = -3 along dz (+1 or -1), origins 1 cm apart; the
@@ -79,7 +56,7 @@ static void write_ini(const char *path, const char *exr)
 {
     char *text = fmt("Width=4\nHeight=3\nAntialias=Off\nOutput_File_Type=E\n"
                      "Output_To_File=On\nOutput_File_Name=%s\nDisplay=Off\n%s", exr, "");
-    put_file(path, text);
+    write_text(path, text);
     free(text);
 }
 
@@ -163,8 +140,8 @@ static const char MODERN_SCENE[] =
 
 Test(povray, renders_a_modern_scene_through_the_lens_camera)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
-    put_file(scene, MODERN_SCENE);
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
+    write_text(scene, MODERN_SCENE);
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
     povray_options o = options(scene, dir, 1);
@@ -173,7 +150,8 @@ Test(povray, renders_a_modern_scene_through_the_lens_camera)
     expect_uniform(fx.chunk[0].output_exr, 0.25f, 0.5f, 0.75f);
     free_fixture(&fx);
     free(scene);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 /* No #version and no assumed_gamma: POV-Ray's own PNG shows the raw 0.25 (64), so the EXR
@@ -181,9 +159,9 @@ Test(povray, renders_a_modern_scene_through_the_lens_camera)
    one) with another display gamma, alpha and antialiasing must not change that. */
 Test(povray, an_old_scene_keeps_its_gamma_and_povray_ini_cannot_change_it)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "old.pov"), *ini = fmt("%s/%s", dir, "povray.ini");
-    put_file(scene, "background { rgb 0.25 }\n");
-    put_file(ini, "Display_Gamma=1.0\nOutput_Alpha=On\nAntialias=On\n");
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "old.pov"), *ini = fmt("%s/%s", dir, "povray.ini");
+    write_text(scene, "background { rgb 0.25 }\n");
+    write_text(ini, "Display_Gamma=1.0\nOutput_Alpha=On\nAntialias=On\n");
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
     povray_options o = options(scene, dir, 1);
@@ -194,17 +172,18 @@ Test(povray, an_old_scene_keeps_its_gamma_and_povray_ini_cannot_change_it)
     free_fixture(&fx);
     free(scene);
     free(ini);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 /* The scene's own includes resolve from its folder, the standard ones from POV-Ray's. */
 Test(povray, includes_resolve_from_the_scene_folder_and_the_library)
 {
-    char *dir = new_dir(), *sub = fmt("%s/%s", dir, "scenes");
+    char *dir = strdup(test_tmpdir()), *sub = fmt("%s/%s", dir, "scenes");
     mkdir(sub, 0777);
     char *scene = fmt("%s/%s", sub, "s.pov"), *mine = fmt("%s/%s", sub, "mine.inc");
-    put_file(mine, "#declare MyColour = rgb <0.5, 0.25, 0>;\n");
-    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n#include \"colors.inc\"\n"
+    write_text(mine, "#declare MyColour = rgb <0.5, 0.25, 0>;\n");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n#include \"colors.inc\"\n"
                     "#include \"mine.inc\"\nbackground { MyColour }\n");
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
@@ -216,17 +195,18 @@ Test(povray, includes_resolve_from_the_scene_folder_and_the_library)
     free(scene);
     free(mine);
     free(sub);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 /* A folder and file name POV-Ray cannot read (a space is fine, é is not): it gets links. */
 Test(povray, scene_paths_that_are_not_ascii_work_and_errors_name_them)
 {
-    char *dir = new_dir(), *sub = fmt("%s/%s", dir, "sc\xc3\xa8ne 1");
+    char *dir = strdup(test_tmpdir()), *sub = fmt("%s/%s", dir, "sc\xc3\xa8ne 1");
     mkdir(sub, 0777);
     char *scene = fmt("%s/%s", sub, "\xc3\xa9t\xc3\xa9.pov"), *mine = fmt("%s/%s", sub, "mine.inc");
-    put_file(mine, "#declare MyColour = rgb 0.5;\n");
-    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+    write_text(mine, "#declare MyColour = rgb 0.5;\n");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
                     "#include \"mine.inc\"\nbackground { MyColour }\n");
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
@@ -235,7 +215,7 @@ Test(povray, scene_paths_that_are_not_ascii_work_and_errors_name_them)
     cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
     expect_uniform(fx.chunk[0].output_exr, 0.5f, 0.5f, 0.5f);
 
-    put_file(mine, "#declare MyColour = rgb 0.5;\nsphere { 0, 1 pigment { foo } }\n");
+    write_text(mine, "#declare MyColour = rgb 0.5;\nsphere { 0, 1 pigment { foo } }\n");
     cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
     char *expected = fmt("%s:%s: ", mine, "2");
     cr_expect(strncmp(err.text, expected, strlen(expected)) == 0, "%s", err.text);
@@ -244,14 +224,15 @@ Test(povray, scene_paths_that_are_not_ascii_work_and_errors_name_them)
     free(scene);
     free(mine);
     free(sub);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 /* POV-Ray's parse error comes back as FILE:LINE: message, nothing else from its log. */
 Test(povray, a_syntax_error_names_the_file_and_line)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "bad.pov");
-    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "bad.pov");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
                     "sphere { <0,0,0>, 1 pigment { rgb 1 }\nbox { 0, 1 }\n");
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
@@ -264,13 +245,14 @@ Test(povray, a_syntax_error_names_the_file_and_line)
     free(expected);
     free_fixture(&fx);
     free(scene);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 Test(povray, a_missing_image_file_is_named)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "img.pov");
-    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n\n"
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "img.pov");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n\n"
                     "plane { z, 1 pigment { image_map { png \"nofile.png\" } } }\n");
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
@@ -282,12 +264,13 @@ Test(povray, a_missing_image_file_is_named)
     free(expected);
     free_fixture(&fx);
     free(scene);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 Test(povray, a_missing_scene_is_bad_input)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "none.pov");
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "none.pov");
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
     povray_options o = options(scene, dir, 1);
@@ -297,13 +280,14 @@ Test(povray, a_missing_scene_is_bad_input)
     cr_expect(access(fx.chunk[0].output_exr, F_OK) != 0);
     free_fixture(&fx);
     free(scene);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 Test(povray, a_missing_povray_says_which_package)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
-    put_file(scene, MODERN_SCENE);
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
+    write_text(scene, MODERN_SCENE);
     fixture fx;
     make_chunks(&fx, dir, 1, (const int[]){1});
     povray_options o = options(scene, dir, 1);
@@ -313,23 +297,24 @@ Test(povray, a_missing_povray_says_which_package)
     cr_expect_str_eq(err.text, "no-such-povray-here: not found (install Debian's povray package)");
     free_fixture(&fx);
     free(scene);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 /* Two chunks at once, the second looking back at another plane. POV-Ray runs behind a
    script that waits until both have started: run one after the other, the first gives up. */
 Test(povray, two_chunks_render_in_parallel)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
     char *script = fmt("%s/%s", dir, "barrier"), *marks = fmt("%s/%s", dir, "started");
-    put_file(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
                     "plane { -z, 0 pigment { rgb <1,0,0> } finish { ambient 1 diffuse 0 } }\n"
                     "plane { z, -10 pigment { rgb <0,1,0> } finish { ambient 1 diffuse 0 } }\n");
     char *text = fmt("#!/bin/sh\ntouch '%s'.$$\nn=0\n"
                      "while [ $(ls '%s'.* | wc -l) -lt 2 ]; do\n"
                      "  n=$((n+1)); [ $n -lt 100 ] || { echo 'not in parallel' >&2; exit 1; }\n"
                      "  sleep 0.05\ndone\nexec povray \"$@\"\n", marks, marks);
-    put_file(script, text);
+    write_text(script, text);
     free(text);
     chmod(script, 0755);
     fixture fx;
@@ -344,21 +329,22 @@ Test(povray, two_chunks_render_in_parallel)
     free(scene);
     free(script);
     free(marks);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }
 
 /* A failing chunk stops the other one (a stand-in for POV-Ray that would sleep for a minute):
    the call returns at once, the sleeper is gone and nothing is left to reap. */
 Test(povray, a_failure_stops_the_other_processes)
 {
-    char *dir = new_dir(), *scene = fmt("%s/%s", dir, "scene.pov");
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
     char *script = fmt("%s/%s", dir, "fakepov"), *pidfile = fmt("%s/%s", dir, "sleeper.pid");
-    put_file(scene, MODERN_SCENE);
+    write_text(scene, MODERN_SCENE);
     char *text = fmt("#!/bin/sh\ncase \"$*\" in\n*c001*) echo $$ > '%s'; exec sleep 60;;\n"
                      "*) while [ ! -s '%s' ]; do sleep 0.05; done\n"
                      "   echo \"File '/x/y.pov' line 7: Parse Error: broken\" >&2; exit 1;;\nesac\n",
                      pidfile, pidfile);
-    put_file(script, text);
+    write_text(script, text);
     free(text);
     chmod(script, 0755);
     fixture fx;
@@ -380,5 +366,6 @@ Test(povray, a_failure_stops_the_other_processes)
     free(scene);
     free(script);
     free(pidfile);
-    remove_dir(dir);
+    remove_tree(dir);
+    free(dir);
 }

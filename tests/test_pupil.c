@@ -162,11 +162,6 @@ Test(pupil, beyond_the_reach_nothing_is_sampled)
    (NAN: the full opening), physical weights. */
 static void setup(camera *c, const char *name, double f_number, double focus_m, pupil_kind kind)
 {
-    char path[512];
-    snprintf(path, sizeof path, LENS_DIR "%s.dat", name);
-    lens l;
-    l2p_error err;
-    cr_assert_eq(lens_read(path, &l, &err), 0, "%s", err.text);
     camera_options o;
     camera_options_default(&o);
     o.width = 64;
@@ -175,7 +170,7 @@ static void setup(camera *c, const char *name, double f_number, double focus_m, 
     o.f_number = f_number;
     o.pupil = kind;
     o.weighting = WEIGHTING_PHYSICAL;
-    cr_assert_eq(camera_setup(c, &l, &o, &err), 0, "%s f/%g: %s", name, f_number, err.text);
+    test_camera(c, name, &o);
 }
 
 /* Film points: the centre, mid-field, mid-edge and corner of the 64x48 film (raster to film

@@ -50,28 +50,6 @@ static bool exists(const char *path)
 }
 
 /* Entries of a folder other than . and ..; names starting with prefix when prefix is given. */
-static int count_entries(const char *dir, const char *prefix, char *listing, size_t size)
-{
-    DIR *d = opendir(dir);
-    cr_assert_not_null(d, "cannot list %s", dir);
-    int n = 0;
-    if (listing && size)
-        listing[0] = '\0';
-    for (struct dirent *e; (e = readdir(d)) != NULL;) {
-        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-            continue;
-        if (prefix && strncmp(e->d_name, prefix, strlen(prefix)))
-            continue;
-        n++;
-        if (listing) {
-            const size_t len = strlen(listing);
-            snprintf(listing + len, size - len, "%s ", e->d_name);
-        }
-    }
-    closedir(d);
-    return n;
-}
-
 /* A number from `lens2pov info --json`. */
 static double json_number(const char *json, const char *key)
 {
@@ -88,16 +66,6 @@ static double json_number(const char *json, const char *key)
 /* A fresh folder (test_tmpdir's buffer is reused by its next call) and paths in it. */
 #define NEW_DIR(d) char d[64]; snprintf(d, sizeof d, "%s", test_tmpdir())
 #define PATH(var, dir, name) char var[512]; snprintf(var, sizeof var, "%s/%s", dir, name)
-
-/* Removes a folder made by test_tmpdir, with everything in it (a failed assertion skips this
-   and leaves the files to look at). */
-static void remove_dir(const char *dir)
-{
-    cr_assert(strncmp(dir, "/tmp/l2ptest.", 13) == 0 && !strchr(dir, '\''), "%s", dir);
-    char cmd[256];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    cr_expect_eq(system(cmd), 0, "%s", cmd);
-}
 
 /* POV-Ray on its own: `povray +Iscene +Oout ...` run in dir, messages to dir/povray.log. */
 static void run_povray(const char *dir, const char *scene, const char *out, int w, int h,
@@ -182,7 +150,7 @@ Test(render, picture_is_upright_and_unmirrored)
               "red %.2f,%.2f and green %.2f,%.2f are not symmetric about the centre", cx[0],
               cy[0], cx[1], cy[1]);
     free(im.p);
-    remove_dir(dir);
+    remove_tree(dir);
 }
 
 /* ---------------------------------------------------------------- POV-Ray's own camera */
@@ -298,7 +266,7 @@ Test(render, agrees_with_povray_perspective_camera)
     free(lens.p);
     free(flat.p);
     free(ref.p);
-    remove_dir(dir);
+    remove_tree(dir);
 }
 
 /* ---------------------------------------------------------------- physical weights */
@@ -389,7 +357,7 @@ Test(render, physical_weights_do_not_depend_on_the_pupil)
         compared++;
     }
     cr_expect_geq(compared, 8, "only %d rings to compare", compared);
-    remove_dir(dir);
+    remove_tree(dir);
 }
 
 /* ---------------------------------------------------------------- failures */
@@ -444,8 +412,8 @@ Test(render, syntax_error_fails_cleanly)
     cr_expect_not_null(strstr(errtext, "pigmnt"), "POV-Ray's message is missing:\n%s", errtext);
     cr_expect_eq(strncmp(errtext, "lens2pov: ", 10), 0, "stderr: %s", errtext);
     free(errtext);
-    remove_dir(getenv("TMPDIR"));
-    remove_dir(dir);
+    remove_tree(getenv("TMPDIR"));
+    remove_tree(dir);
 }
 
 /* POV-Ray fails on the first chunk while the writer is still on the others (--jobs 1, 32
@@ -472,8 +440,8 @@ Test(render, failure_while_the_table_is_written_loses_nothing)
     cr_expect_str_eq(old, "an older file\n", "the --rays file was replaced");
     free(old);
     expect_nothing_left(tmp, dir, out, 2);
-    remove_dir(tmp);
-    remove_dir(dir);
+    remove_tree(tmp);
+    remove_tree(dir);
 }
 
 /* A scene whose last block is never closed: POV-Ray only notices it in the text that follows,
@@ -495,8 +463,8 @@ Test(render, unclosed_block_is_reported_in_the_scene)
     cr_expect_not_null(strstr(errtext, "No matching }"), "POV-Ray's message is missing:\n%s",
                        errtext);
     free(errtext);
-    remove_dir(getenv("TMPDIR"));
-    remove_dir(dir);
+    remove_tree(getenv("TMPDIR"));
+    remove_tree(dir);
 }
 
 Test(render, missing_scene_or_lens_is_bad_input)
@@ -525,8 +493,8 @@ Test(render, missing_scene_or_lens_is_bad_input)
                  listing);
     cr_expect_eq(count_entries(tmp, NULL, listing, sizeof listing), 0,
                  "temporary files left in TMPDIR: %s", listing);
-    remove_dir(tmp);
-    remove_dir(dir);
+    remove_tree(tmp);
+    remove_tree(dir);
 }
 
 /* ---------------------------------------------------------------- crops and chunks */
@@ -587,7 +555,7 @@ Test(render, crop_is_a_region_of_the_whole_picture)
     cr_expect_gt(lit, 0.1 * b.w * b.h, "the crop is black");
     free(a.p);
     free(b.p);
-    remove_dir(dir);
+    remove_tree(dir);
 }
 
 /* A memory budget of 0.05 MB gives chunks of about 200 faces: 32x24 pixels of 6 samples make
@@ -622,7 +590,7 @@ Test(render, chunks_and_jobs_do_not_change_the_picture)
     cr_expect_eq(differ, 0, "%d values differ between 1 chunk and %d chunks", differ, chunks);
     free(a.p);
     free(b.p);
-    remove_dir(dir);
+    remove_tree(dir);
 }
 
 /* POV-Ray starts on the first chunk while the writer is still on the others: the first
@@ -656,7 +624,7 @@ Test(render, povray_starts_on_a_chunk_while_the_rest_are_written)
     const double written = (double)b.st_mtim.tv_sec + 1e-9 * (double)b.st_mtim.tv_nsec;
     cr_expect_lt(started, written, "POV-Ray started %.3f s after the table was complete",
                  started - written);
-    remove_dir(dir);
+    remove_tree(dir);
 }
 
 /* ---------------------------------------------------------------- old and new scenes */
@@ -722,7 +690,7 @@ static void expect_same_as_povray(const char *header, double expected_code)
                  b[0], expected_code);
     free(lens.p);
     free(own.p);
-    remove_dir(dir);
+    remove_tree(dir);
 }
 
 /* An old scene: gamma handling off, colours are gamma-2.2 encoded: 0.3 -> 0.3^2.2 linear. */

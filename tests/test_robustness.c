@@ -50,13 +50,6 @@ static int unexpected_files(const char *dir, const char *const *allowed, const c
     return n;
 }
 
-static void remove_tree(const char *dir)
-{
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    cr_expect_eq(system(cmd), 0);
-}
-
 /* ---------------------------------------------------------------- invalid options */
 
 /* One bad command line: words after "lens2pov" (OUT is replaced by a prefix in a fresh

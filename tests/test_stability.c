@@ -319,13 +319,6 @@ static int split_args(const char *args, char *buf, size_t size, char **words, in
     return n;
 }
 
-static void remove_tree(const char *dir)
-{
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    cr_expect_eq(system(cmd), 0);
-}
-
 /* Nothing but the lens file in dir: no output and no temporary file. */
 static void expect_no_outputs(const char *dir)
 {
