@@ -161,17 +161,31 @@ static int spawn_once(char *const argv[], char **out, char **errout);
 
 int run_lens2pov(char **out, char **errout, ...)
 {
+    char *args[64];
+    int n = 0;
+    va_list ap;
+    va_start(ap, errout);
+    for (char *a; (a = va_arg(ap, char *)) != NULL;) {
+        cr_assert_lt(n, 63, "too many arguments");
+        args[n++] = a;
+    }
+    va_end(ap);
+    args[n] = NULL;
+    return run_lens2pov_argv(out, errout, args);
+}
+
+int run_lens2pov_argv(char **out, char **errout, char *const args[])
+{
     const char *bin = getenv("LENS2POV");
     if (!bin)
         bin = LENS2POV_SOURCE_DIR "/build/lens2pov";
-    char *argv[64];
+    char *argv[128];
     int n = 0;
     argv[n++] = (char *)bin;
-    va_list ap;
-    va_start(ap, errout);
-    for (char *a; (a = va_arg(ap, char *)) != NULL && n < 63;)
-        argv[n++] = a;
-    va_end(ap);
+    for (; args[n - 1]; n++) {
+        cr_assert_lt(n, 127, "too many arguments");
+        argv[n] = args[n - 1];
+    }
     argv[n] = NULL;
     char *o, *e;
     int status = spawn_once(argv, &o, &e);

@@ -16,6 +16,8 @@
    list; stdout and stderr go to files that *out and *errout receive (malloc'd, may be NULL).
    Returns the exit status. */
 int run_lens2pov(char **out, char **errout, ...);
+/* The same with the arguments in a NULL-terminated array. */
+int run_lens2pov_argv(char **out, char **errout, char *const args[]);
 
 /* A fresh folder under /tmp, removed with everything in it when the test's process exits
    (the name is in a buffer the next call reuses), and a path inside a folder (static buffers

@@ -711,3 +711,65 @@ Test(render, scene_without_version)
 {
     expect_same_as_povray("", 0.3 * 255);
 }
+
+/* ---------------------------------------------------------------- chunks and jobs */
+
+/* A checkered sphere on a checkered floor. */
+static const char TINY_SCENE[] =
+    "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+    "background { rgb <0.1, 0.2, 0.3> }\n"
+    "light_source { <-3, 5, -4> color rgb 1 }\n"
+    "sphere { <0, 0, 3>, 0.5 pigment { checker rgb <1,0.2,0.2> rgb <0.2,1,0.2> scale 0.1 } }\n"
+    "plane { y, -0.5 pigment { checker rgb 0.9 rgb 0.1 } }\n";
+
+/* Faces in a chunk's include ("face_indices { N"). */
+static long long faces_in(const char *include_path)
+{
+    char *text = read_text(include_path, NULL);
+    cr_assert_not_null(text, "%s", include_path);
+    const char *at = strstr(text, "face_indices {");
+    cr_assert_not_null(at, "%s has no face_indices", include_path);
+    const long long n = atoll(at + strlen("face_indices {"));
+    free(text);
+    return n;
+}
+
+/* The wide angle vignettes: cutting by samples would give the corner rows' chunk fewer faces.
+   Two jobs get two chunks that together hold every ray the lens passes (the CSV of the same
+   trace); the first is half of them rounded up to whole packed rows by less than a face a row
+   (about 19,400 faces: 10 rows), so the two differ by at most 2 x 9 + 1 faces (cutting by
+   samples gave 12,288 and 7,129 faces; by rows of 1024, 10,240 and 9,177). */
+Test(render, chunks_share_the_faces_equally_between_jobs)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], image[512], keep[512], csv[512], prefix[512];
+    snprintf(scene, sizeof scene, "%s/tiny.pov", dir);
+    snprintf(image, sizeof image, "%s/two.exr", dir);
+    snprintf(keep, sizeof keep, "%s/keep", dir);
+    snprintf(csv, sizeof csv, "%s/rays.csv", dir);
+    snprintf(prefix, sizeof prefix, "%s/rays", dir);
+    write_text(scene, TINY_SCENE);
+    char *errtext = NULL;
+    /* The rear pupil, so that rows differ much in the rays they pass. */
+    const char *camera[] = {"--width", "96", "--height", "64", "--spp", "4", "--look-at", "0,0,3",
+                            "--pupil", "rear"};
+    int st = run_lens2pov(NULL, &errtext, "render", scene, LENS_DIR "wide.22mm.dat", camera[0],
+                          camera[1], camera[2], camera[3], camera[4], camera[5], camera[6],
+                          camera[7], camera[8], camera[9], "--jobs", "2", "--keep-temp", keep,
+                          "-o", image, "--quiet", NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    free(errtext);
+    st = run_lens2pov(NULL, &errtext, "trace", LENS_DIR "wide.22mm.dat", camera[0], camera[1],
+                      camera[2], camera[3], camera[4], camera[5], camera[6], camera[7], camera[8],
+                      camera[9], "--rays", csv, "-o", prefix, "--quiet", NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    free(errtext);
+    size_t passed;
+    free(read_rays_csv(csv, &passed));
+    cr_assert_eq(count_entries(keep, "rays.c", NULL, 0) / 3, 2, "one chunk per job (.inc, .ini, .exr each)");
+    const long long a = faces_in(tmp_path(keep, "rays.c000.inc"));
+    const long long b = faces_in(tmp_path(keep, "rays.c001.inc"));
+    cr_assert_eq(a + b, (long long)passed, "%lld + %lld faces, %zu rays pass", a, b, passed);
+    cr_assert(passed < 96 * 64 * 4 * 0.9, "the lens vignettes: %zu of %d pass", passed, 96 * 64 * 4);
+    cr_assert(a >= b && a - b <= 19, "chunks of %lld and %lld faces", a, b);
+}

@@ -66,7 +66,6 @@
 #include <unistd.h>
 #include "camera/camera.h"
 #include "cli/cli.h"
-#include "image/image_io.h"
 #include "precision_trace.h"
 #include "support.h"
 
@@ -242,13 +241,12 @@ static char *lens_concave_rear(void)
 typedef struct stab_case {
     const char *name;
     const char *what;
-    char *(*make_lens)(void);
+    char *(*lens)(void);           /* the lens file's text (malloc'd) */
     const char *args;              /* options after LENS, space-separated */
-    int expect_status;             /* 0, or 2 for a refusal */
-    const char *expect_message;    /* words of the refusal */
-    int expect_line;               /* > 0: the refusal names LENS:expect_line */
-    double min_pass, max_pass;     /* fraction of the samples that pass */
-    bool expect_tir;               /* some samples end in total internal reflection */
+    const char *refusal;           /* words of the refusal (exit 2); NULL: traced */
+    int refusal_line;              /* > 0: the refusal names LENS:refusal_line */
+    double pass_min, pass_max;     /* fraction of the samples that pass */
+    bool tir;                      /* some samples end in total internal reflection */
     bool closest_focus;            /* args get "--focus-distance D", D the closest possible */
 } stab_case;
 
@@ -281,7 +279,7 @@ static void report(const stab_case *sc, const stab_result *r)
         return;
     char line[2048];
     int n;
-    if (sc->expect_status)
+    if (sc->refusal)
         n = snprintf(line, sizeof line, "%s\t%s\t%s\t%s\n", sc->name, sc->what,
                      strncmp(r->outcome, "FAILS", 5) ? "refused" : "FAILED",
                      r->outcome + (strncmp(r->outcome, "FAILS", 5) ? 0 : 7));
@@ -308,16 +306,6 @@ static void report(const stab_case *sc, const stab_result *r)
 }
 
 /* ---------------------------------------------------------------- checks */
-
-/* Splits the case's options into words, in buf. */
-static int split_args(const char *args, char *buf, size_t size, char **words, int max)
-{
-    int n = 0;
-    snprintf(buf, size, "%s", args ? args : "");
-    for (char *w = strtok(buf, " "); w && n < max; w = strtok(NULL, " "))
-        words[n++] = w;
-    return n;
-}
 
 /* Nothing but the lens file in dir: no output and no temporary file. */
 static void expect_no_outputs(const char *dir)
@@ -541,92 +529,104 @@ static double closest_focus_of(const char *lens_path)
     return d;
 }
 
-static void run_case(const stab_case *sc)
-{
-    const char *dir = test_tmpdir();
-    char lens_path[512], prefix[512], csv[512];
-    snprintf(lens_path, sizeof lens_path, "%s/case.dat", dir);
-    snprintf(prefix, sizeof prefix, "%s/out", dir);
-    snprintf(csv, sizeof csv, "%s/out.csv", dir);
-    char *text = sc->make_lens();
-    write_text(lens_path, text);
-    free(text);
-
+/* The command line of a case: trace LENS, the film, the case's options, --rays, -o.
+   argv points into words and the other buffers of a. */
+typedef struct case_args {
     char *argv[64];
-    int argc = 0;
-    argv[argc++] = "lens2pov";
-    argv[argc++] = "trace";
-    argv[argc++] = lens_path;
-    char size[3][16];
-    snprintf(size[0], 16, "%d", WIDTH);
-    snprintf(size[1], 16, "%d", HEIGHT);
-    snprintf(size[2], 16, "%d", SPP);
-    argv[argc++] = "--width", argv[argc++] = size[0];
-    argv[argc++] = "--height", argv[argc++] = size[1];
-    argv[argc++] = "--spp", argv[argc++] = size[2];
-    char words[512];
-    argc += split_args(sc->args, words, sizeof words, argv + argc, 40);
-    char closest[64];
+    int argc;
+    char words[512], size[3][16], closest[64];
+} case_args;
+
+static void build_args(const stab_case *sc, const char *lens_path, const char *prefix,
+                       const char *csv, case_args *a)
+{
+    char **v = a->argv;
+    int n = 0;
+    v[n++] = "trace";
+    v[n++] = (char *)lens_path;
+    snprintf(a->size[0], 16, "%d", WIDTH);
+    snprintf(a->size[1], 16, "%d", HEIGHT);
+    snprintf(a->size[2], 16, "%d", SPP);
+    v[n++] = "--width", v[n++] = a->size[0];
+    v[n++] = "--height", v[n++] = a->size[1];
+    v[n++] = "--spp", v[n++] = a->size[2];
+    snprintf(a->words, sizeof a->words, "%s", sc->args ? sc->args : "");
+    for (char *w = strtok(a->words, " "); w; w = strtok(NULL, " ")) {
+        cr_assert_lt(n, 50, "%s: too many words", sc->name);
+        v[n++] = w;
+    }
     if (sc->closest_focus) {
         /* The message rounds to 6 digits: a millionth further is within reach. */
-        snprintf(closest, sizeof closest, "%.9g", closest_focus_of(lens_path) * (1 + 1e-6));
-        argv[argc++] = "--focus-distance";
-        argv[argc++] = closest;
+        snprintf(a->closest, sizeof a->closest, "%.9g", closest_focus_of(lens_path) * (1 + 1e-6));
+        v[n++] = "--focus-distance";
+        v[n++] = a->closest;
     }
-    argv[argc++] = "--rays", argv[argc++] = csv;
-    argv[argc++] = "-o", argv[argc++] = prefix;
-    argv[argc++] = "--quiet";
-    argv[argc] = NULL;
+    v[n++] = "--rays", v[n++] = (char *)csv;
+    v[n++] = "-o", v[n++] = (char *)prefix;
+    v[n++] = "--quiet";
+    v[n] = NULL;
+    a->argc = n;
+}
 
-    char *stderr_text = NULL;
-    /* run_lens2pov takes a NULL-terminated list: pass the words one by one. */
-    char *a[64] = {0};
-    for (int i = 1; i < argc; i++)
-        a[i - 1] = argv[i];
-    const int st = run_lens2pov(NULL, &stderr_text, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
-                                a[8], a[9], a[10], a[11], a[12], a[13], a[14], a[15], a[16],
-                                a[17], a[18], a[19], a[20], a[21], a[22], a[23], a[24], a[25],
-                                a[26], a[27], a[28], a[29], a[30], a[31], NULL);
-    /* A copy on the stack: a failed assertion leaves the test without freeing anything. */
-    char errtext[2048];
-    snprintf(errtext, sizeof errtext, "%s", stderr_text ? stderr_text : "");
-    free(stderr_text);
-    cr_assert_lt(argc, 32, "too many words");
+/* A refused case: exit 2, one line "lens2pov: [LENS:LINE: ]..." with the case's words, and
+   nothing written. */
+static void check_refusal(const stab_case *sc, const char *dir, const char *lens_path,
+                          const char *errtext)
+{
+    cr_assert(strncmp(errtext, "lens2pov: ", 10) == 0, "%s: %s", sc->name, errtext);
+    cr_assert_not_null(strstr(errtext, sc->refusal), "%s: '%s' not in: %s", sc->name,
+                       sc->refusal, errtext);
+    if (sc->refusal_line > 0) {
+        char where[600];
+        snprintf(where, sizeof where, "lens2pov: %s:%d: ", lens_path, sc->refusal_line);
+        cr_assert(strncmp(errtext, where, strlen(where)) == 0, "%s: expected '%s' in: %s",
+                  sc->name, where, errtext);
+    }
+    cr_assert(strchr(errtext, '\n') == errtext + strlen(errtext) - 1, "%s: one line: %s",
+              sc->name, errtext);
+    expect_no_outputs(dir);
     stab_result res;
     memset(&res, 0, sizeof res);
-    if (st != sc->expect_status) {
-        /* Into the table too, so that `make stability` shows what happens instead. */
-        const stab_case shown = {.name = sc->name, .what = sc->what, .expect_status = 1};
-        snprintf(res.outcome, sizeof res.outcome, "FAILS: exit %d, expected %d%s%.*s", st,
-                 sc->expect_status, *errtext ? ": " : "", (int)strcspn(errtext, "\n"), errtext);
-        report(&shown, &res);
-    }
-    cr_assert_eq(st, sc->expect_status, "%s: exit %d, expected %d: %s", sc->name, st,
-                 sc->expect_status, errtext);
-    if (sc->expect_status) {
-        cr_assert(strncmp(errtext, "lens2pov: ", 10) == 0, "%s: %s", sc->name, errtext);
-        cr_assert_not_null(strstr(errtext, sc->expect_message), "%s: '%s' not in: %s", sc->name,
-                           sc->expect_message, errtext);
-        if (sc->expect_line > 0) {
-            char where[600];
-            snprintf(where, sizeof where, "lens2pov: %s:%d: ", lens_path, sc->expect_line);
-            cr_assert(strncmp(errtext, where, strlen(where)) == 0, "%s: expected '%s' in: %s",
-                      sc->name, where, errtext);
-        }
-        cr_assert(strchr(errtext, '\n') == errtext + strlen(errtext) - 1, "%s: one line: %s",
-                  sc->name, errtext);
-        expect_no_outputs(dir);
-        snprintf(res.outcome, sizeof res.outcome, "%.*s", (int)strcspn(errtext + 10, "\n"),
-                 errtext + 10);
-        /* Shorten the temporary folder out of the message. */
-        char *p = strstr(res.outcome, dir);
-        if (p)
-            memmove(p, p + strlen(dir) + 1, strlen(p + strlen(dir) + 1) + 1);
-        report(sc, &res);
-        remove_tree(dir);
-        return;
-    }
+    snprintf(res.outcome, sizeof res.outcome, "%.*s", (int)strcspn(errtext + 10, "\n"),
+             errtext + 10);
+    /* Shorten the temporary folder out of the message. */
+    char *p = strstr(res.outcome, dir);
+    if (p)
+        memmove(p, p + strlen(dir) + 1, strlen(p + strlen(dir) + 1) + 1);
+    report(sc, &res);
+}
 
+/* What POV-Ray will see (float32 vertices, the normal of each triangle) against the CSV in
+   world space: within 1e-5 of the lens's size, and 1e-5 rad. A face's vertices lie within 128
+   lone-triangle sizes (half the widest aperture) of the mesh's origin, so float32 moves its
+   centroid by at most sqrt(3) 2^-24 128 / 2 = 6.6e-6 of the size. */
+static void check_include_rays(const stab_case *sc, const camera *cam, const char *inc,
+                               const csv_ray *rows, size_t nrows, stab_result *res)
+{
+    size_t nfaces;
+    pov_ray *seen = read_include_as_povray(inc, &nfaces);
+    const double size_units = lens_size_mm(&cam->lens) / cam->unit_mm;
+    for (size_t k = 0; k < nrows; k++) {
+        const vec3 o = camera_world_from_camera_point(cam, rows[k].o);
+        const vec3 d = camera_world_from_camera_dir(cam, rows[k].d);
+        const double off = v3_length(v3_sub(seen[k].o, o)) / size_units;
+        const double angle = v3_length(v3_sub(seen[k].d, d));
+        res->max_pov_pos = fmax(res->max_pov_pos, off);
+        res->max_pov_angle = fmax(res->max_pov_angle, angle);
+        cr_expect(off <= 1e-5 && angle <= 1e-5,
+                  "%s: face %zu is %g of the lens size and %g rad off its CSV row", sc->name, k,
+                  off, angle);
+    }
+    free(seen);
+}
+
+/* A traced case: finite numbers everywhere, one face a ray, every ray against long double
+   and traced back (check_rays), the include against the CSV, the share that passes. */
+static void check_traced(const stab_case *sc, const case_args *a, const char *lens_path,
+                         const char *prefix, const char *csv)
+{
+    stab_result res;
+    memset(&res, 0, sizeof res);
     size_t nrows;
     csv_ray *rows = read_rays_csv(csv, &nrows);
     for (size_t k = 0; k < nrows; k++) {
@@ -644,38 +644,22 @@ static void run_case(const stab_case *sc)
     /* The same camera in process. */
     cli c;
     l2p_error err;
-    cr_assert_eq(cli_parse(&c, argc, argv, 2, &err), 0, "%s", err.text);
+    char *argv[66] = {"lens2pov"};
+    memcpy(argv + 1, a->argv, sizeof a->argv);
+    cr_assert_eq(cli_parse(&c, a->argc + 1, argv, 2, &err), 0, "%s", err.text);
     lens l;
     cr_assert_eq(lens_read(lens_path, &l, &err), 0, "%s", err.text);
     camera cam;
     cr_assert_eq(camera_setup(&cam, &l, &c.cam, &err), 0, "%s", err.text);
     check_rays(sc, &cam, rows, nrows, &res);
-    /* What POV-Ray will see (float32 vertices, the normal of each triangle) against the CSV
-       in world space: within 1e-5 of the lens's size, and 1e-5 rad. A face's vertices lie
-       within 128 lone-triangle sizes (half the widest aperture) of the mesh's origin, so
-       float32 moves its centroid by at most sqrt(3) 2^-24 128 / 2 = 6.6e-6 of the size. */
-    size_t nfaces;
-    pov_ray *seen = read_include_as_povray(inc, &nfaces);
-    const double size_units = lens_size_mm(&cam.lens) / cam.unit_mm;
-    for (size_t k = 0; k < nrows; k++) {
-        const vec3 o = camera_world_from_camera_point(&cam, rows[k].o);
-        const vec3 d = camera_world_from_camera_dir(&cam, rows[k].d);
-        const double off = v3_length(v3_sub(seen[k].o, o)) / size_units;
-        const double angle = v3_length(v3_sub(seen[k].d, d));
-        res.max_pov_pos = fmax(res.max_pov_pos, off);
-        res.max_pov_angle = fmax(res.max_pov_angle, angle);
-        cr_expect(off <= 1e-5 && angle <= 1e-5,
-                  "%s: face %zu is %g of the lens size and %g rad off its CSV row", sc->name, k,
-                  off, angle);
-    }
-    free(seen);
+    check_include_rays(sc, &cam, inc, rows, nrows, &res);
     free(rows);
 
     const double pass = (double)res.passed / (double)res.samples;
-    cr_expect(pass >= sc->min_pass && pass <= sc->max_pass,
+    cr_expect(pass >= sc->pass_min && pass <= sc->pass_max,
               "%s: %.2f%% of the rays pass, expected %.2f%% .. %.2f%%", sc->name, 100 * pass,
-              100 * sc->min_pass, 100 * sc->max_pass);
-    if (sc->expect_tir)
+              100 * sc->pass_min, 100 * sc->pass_max);
+    if (sc->tir)
         cr_expect_gt(res.tir, 0, "%s: no total internal reflection", sc->name);
     snprintf(res.outcome, sizeof res.outcome, "; film distance %.6g mm", cam.lens.film_distance_mm);
     report(sc, &res);
@@ -684,87 +668,139 @@ static void run_case(const stab_case *sc)
                 res.max_pos, res.max_back, res.hair, res.max_angle_hair, res.max_pos_hair,
                 res.disagree, res.disagree_hair, res.max_back_ld);
     camera_free(&cam);
-    remove_tree(dir);
+}
+
+static void run_case(const stab_case *sc)
+{
+    const char *dir = test_tmpdir();
+    char lens_path[512], prefix[512], csv[512];
+    snprintf(lens_path, sizeof lens_path, "%s/case.dat", dir);
+    snprintf(prefix, sizeof prefix, "%s/out", dir);
+    snprintf(csv, sizeof csv, "%s/out.csv", dir);
+    char *text = sc->lens();
+    write_text(lens_path, text);
+    free(text);
+    case_args a;
+    build_args(sc, lens_path, prefix, csv, &a);
+    char *stderr_text = NULL;
+    const int st = run_lens2pov_argv(NULL, &stderr_text, a.argv);
+    /* A copy on the stack: a failed assertion leaves the test without freeing anything. */
+    char errtext[2048];
+    snprintf(errtext, sizeof errtext, "%s", stderr_text ? stderr_text : "");
+    free(stderr_text);
+    const int expected = sc->refusal ? 2 : 0;
+    if (st != expected) {
+        /* Into the table too, so that `make stability` shows what happens instead. */
+        const stab_case shown = {.name = sc->name, .what = sc->what, .refusal = ""};
+        stab_result res;
+        memset(&res, 0, sizeof res);
+        snprintf(res.outcome, sizeof res.outcome, "FAILS: exit %d, expected %d%s%.*s", st,
+                 expected, *errtext ? ": " : "", (int)strcspn(errtext, "\n"), errtext);
+        report(&shown, &res);
+    }
+    cr_assert_eq(st, expected, "%s: exit %d, expected %d: %s", sc->name, st, expected, errtext);
+    if (sc->refusal)
+        check_refusal(sc, dir, lens_path, errtext);
+    else
+        check_traced(sc, &a, lens_path, prefix, csv);
 }
 
 /* ---------------------------------------------------------------- the table */
 
 static const stab_case CASES[] = {
-    {"flat-1e6", "near-flat surfaces |R| = 1e6 (window and plate around the double Gauss)",
-     lens_flat_1e6, "--focus-distance 3", 0, NULL, 0, 0.5, 1.0, false, false},
-    {"flat-1e9", "near-flat surfaces |R| = 1e9", lens_flat_1e9, "--focus-distance 3", 0, NULL, 0,
-     0.5, 1.0, false, false},
-    {"flat-1e12", "near-flat surfaces |R| = 1e12", lens_flat_1e12, "--focus-distance 3", 0,
-     NULL, 0, 0.5, 1.0, false, false},
-    {"flat-m1e12", "near-flat surfaces |R| = 1e12, signs swapped", lens_flat_m1e12,
-     "--focus-distance 3", 0, NULL, 0, 0.5, 1.0, false, false},
-    {"hemisphere", "full hemisphere facing the film, rear pupil on its rim", lens_hemisphere,
-     "--pupil rear --focus-distance inf --film-diagonal 20", 0, NULL, 0, 0.05, 1.0, false,
-     false},
-    {"tir", "total internal reflection inside the field", lens_tir,
-     "--focus-distance inf --film-diagonal 60 --pupil stop", 0, NULL, 0, 0.05, 0.95, true, false},
-    {"fisheye-corners", "fisheye, full-frame film (43.3 mm): its corners", lens_fisheye,
-     "--film-diagonal 43.3 --focus-distance 3", 0, NULL, 0, 0.2, 1.0, false, false},
+    {.name = "flat-1e6",
+     .what = "near-flat surfaces |R| = 1e6 (window and plate around the double Gauss)",
+     .lens = lens_flat_1e6, .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "flat-1e9", .what = "near-flat surfaces |R| = 1e9", .lens = lens_flat_1e9,
+     .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "flat-1e12", .what = "near-flat surfaces |R| = 1e12", .lens = lens_flat_1e12,
+     .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "flat-m1e12", .what = "near-flat surfaces |R| = 1e12, signs swapped",
+     .lens = lens_flat_m1e12, .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "hemisphere", .what = "full hemisphere facing the film, rear pupil on its rim",
+     .lens = lens_hemisphere, .args = "--pupil rear --focus-distance inf --film-diagonal 20",
+     .pass_min = 0.05, .pass_max = 1.0},
+    {.name = "tir", .what = "total internal reflection inside the field", .lens = lens_tir,
+     .args = "--focus-distance inf --film-diagonal 60 --pupil stop", .pass_min = 0.05,
+     .pass_max = 0.95, .tir = true},
+    {.name = "fisheye-corners", .what = "fisheye, full-frame film (43.3 mm): its corners",
+     .lens = lens_fisheye, .args = "--film-diagonal 43.3 --focus-distance 3", .pass_min = 0.2,
+     .pass_max = 1.0},
     /* Film points beyond the image circle produce no samples (the pupil's reach): the samples
        left are those inside it, near its rim. */
-    {"fisheye-beyond", "fisheye, 200 mm film: far beyond its image circle", lens_fisheye,
-     "--film-diagonal 200 --focus-distance 3 --pupil rear", 0, NULL, 0, 0.001, 1.0, false, false},
-    {"scale-1e-3", "double Gauss scaled by 1e-3 (f = 50 um)", lens_dgauss_milli,
-     "--film-diagonal 0.035 --unit-mm 1 --focus-distance 3", 0, NULL, 0, 0.5, 1.0, false, false},
-    {"scale-1e3", "double Gauss scaled by 1e3 (f = 50 m)", lens_dgauss_kilo,
-     "--film-diagonal 35000 --unit-mm 1 --focus-distance 3e6", 0, NULL, 0, 0.5, 1.0, false, false},
+    {.name = "fisheye-beyond", .what = "fisheye, 200 mm film: far beyond its image circle",
+     .lens = lens_fisheye, .args = "--film-diagonal 200 --focus-distance 3 --pupil rear",
+     .pass_min = 0.001, .pass_max = 1.0},
+    {.name = "scale-1e-3", .what = "double Gauss scaled by 1e-3 (f = 50 um)",
+     .lens = lens_dgauss_milli, .args = "--film-diagonal 0.035 --unit-mm 1 --focus-distance 3",
+     .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "scale-1e3", .what = "double Gauss scaled by 1e3 (f = 50 m)",
+     .lens = lens_dgauss_kilo, .args = "--film-diagonal 35000 --unit-mm 1 --focus-distance 3e6",
+     .pass_min = 0.5, .pass_max = 1.0},
     /* The stop-image pupil is fitted with real rays: it follows a 1 um stop off axis, where
        the stop's paraxial image misses it (pupil aberration). */
-    {"aperture-1um", "aperture 1e-3 mm (stop-image pupil)", lens_dgauss,
-     "--aperture-diameter 0.001", 0, NULL, 0, 0.005, 1.0, false, false},
-    {"focus-inf", "focus at infinity", lens_dgauss, "--focus-distance inf", 0, NULL, 0, 0.5, 1.0,
-     false, false},
-    {"focus-closest", "focus at the closest distance the lens allows", lens_dgauss,
-     "--unit-mm 1", 0, NULL, 0, 0.2, 1.0, false, true},
-    {"focus-too-close", "focus closer than the lens allows", lens_dgauss,
-     "--focus-distance 0.05", 2, "closer than this lens can focus: the closest is ", 0, 0, 0,
-     false, false},
-    {"afocal-rear-near", "nearly afocal subsystem behind the stop (stop-image pupil)",
-     lens_afocal_rear_near, "--focus-distance 3", 0, NULL, 0, 0.05, 1.0, false, false},
-    {"afocal-whole", "afocal whole lens", lens_afocal_whole_exact, "--focus-distance inf", 2,
-     "form an afocal system", 1, 0, 0, false, false},
+    {.name = "aperture-1um", .what = "aperture 1e-3 mm (stop-image pupil)", .lens = lens_dgauss,
+     .args = "--aperture-diameter 0.001", .pass_min = 0.005, .pass_max = 1.0},
+    {.name = "focus-inf", .what = "focus at infinity", .lens = lens_dgauss,
+     .args = "--focus-distance inf", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "focus-closest", .what = "focus at the closest distance the lens allows",
+     .lens = lens_dgauss, .args = "--unit-mm 1", .pass_min = 0.2, .pass_max = 1.0,
+     .closest_focus = true},
+    {.name = "focus-too-close", .what = "focus closer than the lens allows", .lens = lens_dgauss,
+     .args = "--focus-distance 0.05",
+     .refusal = "closer than this lens can focus: the closest is "},
+    {.name = "afocal-rear-near",
+     .what = "nearly afocal subsystem behind the stop (stop-image pupil)",
+     .lens = lens_afocal_rear_near, .args = "--focus-distance 3", .pass_min = 0.05,
+     .pass_max = 1.0},
+    {.name = "afocal-whole", .what = "afocal whole lens", .lens = lens_afocal_whole_exact,
+     .args = "--focus-distance inf", .refusal = "form an afocal system", .refusal_line = 1},
     /* Camera space is absolute: a film 6.5e6 mm behind the lens leaves each coordinate
        ulp(6.5e6) = 1e-9 mm, and the error grows like (film distance)^2 on the way back to the
        film (0.04 mm at 1e8 mm, 20 mm at 1.3e10 mm, the most thick_lens_of accepts). Such a
        film is refused: at most FILM_DISTANCE_MAX_RATIO (1000) times the lens's size. */
-    {"afocal-whole-near", "nearly afocal whole lens (f = 7e6 mm), focus at infinity",
-     lens_afocal_whole_near, "--focus-distance inf", 2, "too far", 1, 0, 0, false, false},
-    {"afocal-whole-edge", "nearly afocal whole lens (f = 1.3e10 mm, the most accepted as focal)",
-     lens_afocal_whole_edge, "--focus-distance inf", 2, "too far", 1, 0, 0, false, false},
-    {"film-far", "film 1e4 mm behind the double Gauss (300 times its size)", lens_dgauss,
-     "--film-distance 1e4", 0, NULL, 0, 0.2, 1.0, false, false},
-    {"film-too-far", "film 1e5 mm behind the double Gauss (3000 times its size)", lens_dgauss,
-     "--film-distance 1e5", 2, "too far", 0, 0, 0, false, false},
-    {"stop-first", "the stop as the first surface", lens_stop_first, "--focus-distance 3", 0,
-     NULL, 0, 0.5, 1.0, false, false},
-    {"stop-last", "the stop as the last surface", lens_stop_last, "--focus-distance 3", 0, NULL,
-     0, 0.5, 1.0, false, false},
-    {"single-surface", "a single refracting surface (film in the glass)", lens_single_surface,
-     "--focus-distance 3 --film-diagonal 10", 0, NULL, 0, 0.5, 1.0, false, false},
+    {.name = "afocal-whole-near",
+     .what = "nearly afocal whole lens (f = 7e6 mm), focus at infinity",
+     .lens = lens_afocal_whole_near, .args = "--focus-distance inf", .refusal = "too far",
+     .refusal_line = 1},
+    {.name = "afocal-whole-edge",
+     .what = "nearly afocal whole lens (f = 1.3e10 mm, the most accepted as focal)",
+     .lens = lens_afocal_whole_edge, .args = "--focus-distance inf", .refusal = "too far",
+     .refusal_line = 1},
+    {.name = "film-far", .what = "film 1e4 mm behind the double Gauss (300 times its size)",
+     .lens = lens_dgauss, .args = "--film-distance 1e4", .pass_min = 0.2, .pass_max = 1.0},
+    {.name = "film-too-far", .what = "film 1e5 mm behind the double Gauss (3000 times its size)",
+     .lens = lens_dgauss, .args = "--film-distance 1e5", .refusal = "too far"},
+    {.name = "stop-first", .what = "the stop as the first surface", .lens = lens_stop_first,
+     .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "stop-last", .what = "the stop as the last surface", .lens = lens_stop_last,
+     .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "single-surface", .what = "a single refracting surface (film in the glass)",
+     .lens = lens_single_surface, .args = "--focus-distance 3 --film-diagonal 10", .pass_min = 0.5,
+     .pass_max = 1.0},
     /* The stop-image pupil is fitted to the passing rays and aims at none that reflect;
        the rear pupil (next) aims at them. */
-    {"film-distance-0", "film distance 0 (film on the rear vertex)", lens_dgauss,
-     "--film-distance 0", 0, NULL, 0, 0.05, 1.0, false, false},
-    {"film-distance-0-rear", "film distance 0, rear pupil", lens_dgauss,
-     "--film-distance 0 --pupil rear", 0, NULL, 0, 0.0005, 1.0, true, false},
-    {"film-distance-0-stop-last", "film distance 0 with the stop last: pupil in the film plane",
-     lens_stop_last, "--film-distance 0", 2, "lies in the film plane", 3, 0, 0, false, false},
-    {"film-in-glass", "film distance 0 behind a concave rear surface", lens_concave_rear,
-     "--film-distance 0", 2, "inside the lens", 3, 0, 0, false, false},
+    {.name = "film-distance-0", .what = "film distance 0 (film on the rear vertex)",
+     .lens = lens_dgauss, .args = "--film-distance 0", .pass_min = 0.05, .pass_max = 1.0},
+    {.name = "film-distance-0-rear", .what = "film distance 0, rear pupil", .lens = lens_dgauss,
+     .args = "--film-distance 0 --pupil rear", .pass_min = 0.0005, .pass_max = 1.0, .tir = true},
+    {.name = "film-distance-0-stop-last",
+     .what = "film distance 0 with the stop last: pupil in the film plane", .lens = lens_stop_last,
+     .args = "--film-distance 0", .refusal = "lies in the film plane", .refusal_line = 3},
+    {.name = "film-in-glass", .what = "film distance 0 behind a concave rear surface",
+     .lens = lens_concave_rear, .args = "--film-distance 0", .refusal = "inside the lens",
+     .refusal_line = 3},
     /* The extremes of --unit-mm: the include must stay within float32 for POV-Ray. */
-    {"unit-um", "scene units of 1 um (--unit-mm 1e-3), lens x 1e3", lens_dgauss_kilo,
-     "--film-diagonal 35000 --unit-mm 1e-3 --focus-distance 3e9", 0, NULL, 0, 0.5, 1.0, false,
-     false},
-    {"unit-1000km", "scene units of 1000 km (--unit-mm 1e9), lens x 1e-3", lens_dgauss_milli,
-     "--film-diagonal 0.035 --unit-mm 1e9 --focus-distance 3e-9", 0, NULL, 0, 0.5, 1.0, false,
-     false},
-    {"thick-trace", "thick-lens tracing of the fisheye, 200 mm film", lens_fisheye,
-     "--trace thick --film-diagonal 200", 0, NULL, 0, 0.0, 1.0, false, false},
+    {.name = "unit-um", .what = "scene units of 1 um (--unit-mm 1e-3), lens x 1e3",
+     .lens = lens_dgauss_kilo, .args = "--film-diagonal 35000 --unit-mm 1e-3 --focus-distance 3e9",
+     .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "unit-1000km", .what = "scene units of 1000 km (--unit-mm 1e9), lens x 1e-3",
+     .lens = lens_dgauss_milli,
+     .args = "--film-diagonal 0.035 --unit-mm 1e9 --focus-distance 3e-9", .pass_min = 0.5,
+     .pass_max = 1.0},
+    {.name = "thick-trace", .what = "thick-lens tracing of the fisheye, 200 mm film",
+     .lens = lens_fisheye, .args = "--trace thick --film-diagonal 200", .pass_min = 0.0,
+     .pass_max = 1.0},
 };
 
 enum { CASE_COUNT = sizeof CASES / sizeof CASES[0] };
@@ -956,133 +992,3 @@ Test(stability, sweep_to_the_critical_angle)
           10.0 / 1.5, +1);
 }
 
-/* ---------------------------------------------------------------- a table too large */
-
-/* A ray table too large for one POV-Ray process: `render --memory-mb` caps each process's
-   share, and the table is split into chunks rendered one process each. A tiny budget (0.15 MB,
-   about 730 faces at 215 bytes a face) splits the ~9,400 faces of 64 x 48 x 4 samples into a
-   dozen chunks: the developed image must equal the one-chunk render bit for bit (both are
-   half-float EXR of the same samples and weights). */
-static const char TINY_SCENE[] =
-    "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
-    "background { rgb <0.1, 0.2, 0.3> }\n"
-    "light_source { <-3, 5, -4> color rgb 1 }\n"
-    "sphere { <0, 0, 3>, 0.5 pigment { checker rgb <1,0.2,0.2> rgb <0.2,1,0.2> scale 0.1 } }\n"
-    "plane { y, -0.5 pigment { checker rgb 0.9 rgb 0.1 } }\n";
-
-static int count_files_ending(const char *dir, const char *suffix)
-{
-    DIR *d = opendir(dir);
-    cr_assert_not_null(d, "%s", dir);
-    int n = 0;
-    for (struct dirent *e; (e = readdir(d)) != NULL;) {
-        const size_t a = strlen(e->d_name), b = strlen(suffix);
-        n += a > b && !strcmp(e->d_name + a - b, suffix);
-    }
-    closedir(d);
-    return n;
-}
-
-/* Faces in a chunk's include ("face_indices { N"). */
-static long long faces_in(const char *include_path)
-{
-    char *text = read_text(include_path, NULL);
-    cr_assert_not_null(text, "%s", include_path);
-    const char *at = strstr(text, "face_indices {");
-    cr_assert_not_null(at, "%s has no face_indices", include_path);
-    const long long n = atoll(at + strlen("face_indices {"));
-    free(text);
-    return n;
-}
-
-/* The wide angle vignettes: cutting by samples would give the corner rows' chunk fewer faces.
-   Two jobs get two chunks that together hold every ray the lens passes (the CSV of the same
-   trace); the first is half of them rounded up to whole packed rows by less than a face a row
-   (about 19,400 faces: 10 rows), so the two differ by at most 2 x 9 + 1 faces (cutting by
-   samples gave 12,288 and 7,129 faces; by rows of 1024, 10,240 and 9,177). */
-Test(stability, chunks_share_the_faces_equally_between_jobs)
-{
-    const char *dir = test_tmpdir();
-    char scene[512], image[512], keep[512], csv[512], prefix[512];
-    snprintf(scene, sizeof scene, "%s/tiny.pov", dir);
-    snprintf(image, sizeof image, "%s/two.exr", dir);
-    snprintf(keep, sizeof keep, "%s/keep", dir);
-    snprintf(csv, sizeof csv, "%s/rays.csv", dir);
-    snprintf(prefix, sizeof prefix, "%s/rays", dir);
-    write_text(scene, TINY_SCENE);
-    char *errtext = NULL;
-    /* The rear pupil, so that rows differ much in the rays they pass. */
-    const char *camera[] = {"--width", "96", "--height", "64", "--spp", "4", "--look-at", "0,0,3",
-                            "--pupil", "rear"};
-    int st = run_lens2pov(NULL, &errtext, "render", scene, LENS_DIR "wide.22mm.dat", camera[0],
-                          camera[1], camera[2], camera[3], camera[4], camera[5], camera[6],
-                          camera[7], camera[8], camera[9], "--jobs", "2", "--keep-temp", keep,
-                          "-o", image, "--quiet", NULL);
-    cr_assert_eq(st, 0, "%s", errtext);
-    free(errtext);
-    st = run_lens2pov(NULL, &errtext, "trace", LENS_DIR "wide.22mm.dat", camera[0], camera[1],
-                      camera[2], camera[3], camera[4], camera[5], camera[6], camera[7], camera[8],
-                      camera[9], "--rays", csv, "-o", prefix, "--quiet", NULL);
-    cr_assert_eq(st, 0, "%s", errtext);
-    free(errtext);
-    size_t passed;
-    free(read_rays_csv(csv, &passed));
-    cr_assert_eq(count_files_ending(keep, ".inc"), 2, "one chunk per job");
-    const long long a = faces_in(tmp_path(keep, "rays.c000.inc"));
-    const long long b = faces_in(tmp_path(keep, "rays.c001.inc"));
-    cr_assert_eq(a + b, (long long)passed, "%lld + %lld faces, %zu rays pass", a, b, passed);
-    cr_assert(passed < 96 * 64 * 4 * 0.9, "the lens vignettes: %zu of %d pass", passed, 96 * 64 * 4);
-    cr_assert(a >= b && a - b <= 19, "chunks of %lld and %lld faces", a, b);
-}
-
-Test(stability, ray_table_too_large_for_one_povray_process)
-{
-    const char *dir = test_tmpdir();
-    char scene[512], one[512], many[512], keep[512];
-    snprintf(scene, sizeof scene, "%s/tiny.pov", dir);
-    snprintf(one, sizeof one, "%s/one.exr", dir);
-    snprintf(many, sizeof many, "%s/many.exr", dir);
-    snprintf(keep, sizeof keep, "%s/keep", dir);
-    write_text(scene, TINY_SCENE);
-    char *errtext = NULL;
-    int st = run_lens2pov(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width",
-                          "64", "--height", "48", "--spp", "4", "--look-at", "0,0,3", "--jobs",
-                          "1", "-o", one, "--quiet", NULL);
-    cr_assert_eq(st, 0, "one chunk: %s", errtext);
-    free(errtext);
-    st = run_lens2pov(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "64",
-                      "--height", "48", "--spp", "4", "--look-at", "0,0,3", "--memory-mb", "0.15",
-                      "--keep-temp", keep, "-o", many, "--quiet", NULL);
-    cr_assert_eq(st, 0, "many chunks: %s", errtext);
-    free(errtext);
-    const int chunks = count_files_ending(keep, ".inc");
-    cr_assert_geq(chunks, 10, "a 0.15 MB budget splits ~9400 faces into chunks: %d", chunks);
-    int w1, h1, w2, h2;
-    float *p1, *p2;
-    l2p_error err;
-    cr_assert_eq(image_read_rgba(one, &w1, &h1, &p1, &err), 0, "%s", err.text);
-    cr_assert_eq(image_read_rgba(many, &w2, &h2, &p2, &err), 0, "%s", err.text);
-    cr_assert(w1 == 64 && h1 == 48 && w2 == 64 && h2 == 48);
-    int differ = 0;
-    float sum = 0;
-    for (int i = 0; i < w1 * h1 * 4; i++) {
-        cr_assert(isfinite(p1[i]) && isfinite(p2[i]), "pixel value %d not finite", i);
-        differ += p1[i] != p2[i];
-        sum += p1[i];
-    }
-    cr_expect_eq(differ, 0, "%d channel values differ between 1 and %d chunks", differ, chunks);
-    cr_expect_gt(sum, 0, "the render is not black");
-    free(p1);
-    free(p2);
-    const char *file = getenv("L2P_STABILITY_REPORT");
-    if (file && *file) {
-        FILE *f = fopen(file, "a");
-        if (f) {
-            fprintf(f, "big-table\tray table too large for one POV-Ray process (render "
-                       "--memory-mb 0.15)\trendered\t%d POV-Ray processes; the image equals "
-                       "the 1-process render (%d values differ)\n", chunks, differ);
-            fclose(f);
-        }
-    }
-    remove_tree(dir);
-}

@@ -29,7 +29,7 @@ order='flat-1e6 flat-1e9 flat-1e12 flat-m1e12 hemisphere tir sweep-grazing sweep
 sweep-tir fisheye-corners fisheye-beyond scale-1e-3 scale-1e3 unit-um unit-1000km aperture-1um
 focus-inf focus-closest focus-too-close afocal-rear-near afocal-whole afocal-whole-near
 afocal-whole-edge film-far film-too-far stop-first stop-last single-surface film-distance-0
-film-distance-0-rear film-distance-0-stop-last film-in-glass thick-trace big-table'
+film-distance-0-rear film-distance-0-stop-last film-in-glass thick-trace'
 sorted=$report.sorted
 trap 'rm -f "$report" "$log" "$sorted"' EXIT
 for name in $order; do grep "^$name	" "$report"; done >"$sorted"
