@@ -51,7 +51,7 @@ typedef struct pov_camera {
     vec3 location, direction, up, right, sky, look_at, focus;
     double angle;
     bool has_look_at, has_angle, declared, unsupported;
-    affine trans;
+    affine trans, pending;     /* the transforms so far; the one being read */
     double version;
 } pov_camera;
 
@@ -170,15 +170,18 @@ static bool take_item(pov_camera *c, const char *msg, const char *scene, int lin
             apply_angle(c);
         return true;
     }
-    if (!strcmp(word, "transform")) {
-        if (!read_numbers(rest, v, 12))
+    /* A transform: its images of the origin and of x, y and z, one a message. */
+    if (word[0] == 't' && word[1] >= '0' && word[1] <= '3' && !word[2]) {
+        vec3 *slot[4] = {&c->pending.o, &c->pending.ex, &c->pending.ey, &c->pending.ez};
+        if (!read_numbers(rest, v, 3))
             return false;
-        const affine m = {v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]), v3(v[6], v[7], v[8]),
-                          v3(v[9], v[10], v[11])};
+        *slot[word[1] - '0'] = v3(v[0], v[1], v[2]);
+        if (word[1] != '3')
+            return true;
         if (old)
-            apply_transform(c, &m);
+            apply_transform(c, &c->pending);
         else
-            c->trans = affine_then(&c->trans, &m);
+            c->trans = affine_then(&c->trans, &c->pending);
         return true;
     }
     if (!read_numbers(rest, v, 3))

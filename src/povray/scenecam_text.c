@@ -197,15 +197,19 @@ static void put_item(text *t, const char *s, size_t a, size_t b, size_t e, enum 
                  "#declare Lens2pov_Transform = function { transform { ");
         puts_(t, name);
         put_expression(t, s, b, e);
-        puts_(t, " } } #debug concat(\"\\nlens2pov-transform\",");
-        put_vector(t, "Lens2pov_Transform(0, 0, 0)");
-        puts_(t, ", \" \",");
-        put_vector(t, "Lens2pov_Transform(1, 0, 0)");
-        puts_(t, ", \" \",");
-        put_vector(t, "Lens2pov_Transform(0, 1, 0)");
-        puts_(t, ", \" \",");
-        put_vector(t, "Lens2pov_Transform(0, 0, 1)");
-        puts_(t, ", \"|\\n\") ");
+        puts_(t, " } } ");
+        /* One vector a message: POV-Ray drops or cuts longer #debug strings. */
+        static const char *const points[4][2] = {{"t0", "(0, 0, 0)"}, {"t1", "(1, 0, 0)"},
+                                                 {"t2", "(0, 1, 0)"}, {"t3", "(0, 0, 1)"}};
+        for (int k = 0; k < 4; k++) {
+            puts_(t, "#debug concat(\"\\nlens2pov-");
+            puts_(t, points[k][0]);
+            puts_(t, " \",");
+            char call[64];
+            snprintf(call, sizeof call, "Lens2pov_Transform%s", points[k][1]);
+            put_vector(t, call);
+            puts_(t, ", \"|\\n\") ");
+        }
     } else if (kind == ITEM_TYPE) {
         puts_(t, "#debug \"\\nlens2pov-type ");
         puts_(t, name);
