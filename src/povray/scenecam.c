@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -372,6 +373,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     outfile_block_signals(&old);
     const pid_t pid = fork();
     if (pid == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGTERM);   /* gone with lens2pov, however it ends */
         signal(SIGINT, SIG_DFL);
         signal(SIGTERM, SIG_DFL);
         signal(SIGHUP, SIG_DFL);
@@ -428,9 +430,14 @@ static int probe(const char *scene, const char *dir, const char *work, int w, in
     if (!text)
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
     char *rewritten = memchr(text, '\0', n) ? NULL : scene_camera_rewrite(text, n);
+    const bool no_camera = rewritten && !strcmp(rewritten, text);
     free(text);
     if (!rewritten)
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file (or out of memory)");
+    if (no_camera) {   /* POV-Ray's default camera: nothing for POV-Ray to evaluate */
+        free(rewritten);
+        return scene_camera_from_log("", 0, scene, out, err);
+    }
     int st = write_all(copy, rewritten, err);
     free(rewritten);
     if (!st) {
