@@ -8,9 +8,9 @@
 # and OUTDIR/contact-sheet.png. Extra options go to every `lens2pov render`.
 # Defaults, each used only when you give none of its kind:
 #   size      --width 320 --height 240 --spp 16
-#   placement the `location`, `look_at` and `sky` of the scene's first camera block when they
-#             are plain number vectors; otherwise lens2pov's default (at the origin, looking
-#             along +z): then pass --location and --look-at yourself.
+#   placement the scene's own camera (lens2pov render's default without --location,
+#             --look-at and --sky); the film 35 mm full frame unless --angle or
+#             --film-diagonal is given.
 # Environment: LENS2POV (the binary; default build/lens2pov of this repo, else lens2pov on
 # PATH), LENS_DIR (default lenses/ of this repo), FONT (oiiotool font, default DejaVuSans).
 #
@@ -52,60 +52,20 @@ for lens in "$lens_dir"/*.dat; do
 done
 
 # Which kinds of options did the user give? (--opt VALUE and --opt=VALUE both count.)
-have_size='' have_place=''
+have_size=''
 for a in "$@"; do
     case $a in
         --width | --width=* | --height | --height=*) have_size=1 ;;
-        --location | --location=* | --look-at | --look-at=*) have_place=1 ;;
         -o | --output | --output=* | --pupil | --pupil=* | --trace | --trace=*)
             die "$a is set by this script (it renders every variant into OUTDIR)" ;;
     esac
 done
 
-# The first `camera { ... }` of the scene: location, look_at and sky when each is a literal
-# vector <x, y, z>. Anything that moves the camera otherwise (transforms, #declared vectors)
-# makes it give up, rather than guess a wrong placement.
-scene_camera() {
-    sed 's://.*$::' "$1" | tr '\n\t\r' '   ' | awk '
-    {
-        s = $0
-        if (!match(s, /(^|[^A-Za-z0-9_])camera[ ]*\{/)) exit
-        s = substr(s, RSTART + RLENGTH); depth = 1; body = ""
-        for (i = 1; i <= length(s) && depth > 0; i++) {
-            c = substr(s, i, 1)
-            if (c == "{") depth++
-            if (c == "}") depth--
-            if (depth > 0) body = body c
-        }
-        if (body ~ /(translate|rotate|scale|matrix|transform|[{])/) exit
-        num = "[ ]*[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?[ ]*"
-        vec = "<" num "," num "," num ">"
-        n = split("location look_at sky", key, " ")
-        split("--location --look-at --sky", opt, " ")
-        out = ""
-        for (k = 1; k <= n; k++) {
-            if (match(body, key[k] "[ ]*" vec)) {
-                v = substr(body, RSTART, RLENGTH)
-                sub(/^[a-z_]+[ ]*</, "", v); sub(/>$/, "", v); gsub(/ /, "", v)
-                out = out " " opt[k] " " v
-            } else if (body ~ key[k]) exit
-        }
-        if (out ~ /--location/ && out ~ /--look-at/) print out
-    }'
-}
-
 defaults=''
 [ -n "$have_size" ] || defaults='--width 320 --height 240 --spp 16'
-if [ -z "$have_place" ]; then
-    cam=$(scene_camera "$scene")
-    if [ -n "$cam" ]; then
-        say "camera from the scene:$cam"
-        defaults="$defaults$cam"
-    else
-        say "warning: no plain camera { location <..> look_at <..> } in $scene; lens2pov's default" \
-            "placement applies (origin, looking along +z): pass --location and --look-at"
-    fi
-fi
+# Without --location, --look-at and --sky, lens2pov render places the lens as the scene's own
+# camera, evaluated by POV-Ray (README). The film stays 35 mm, so that each lens shows its own
+# field of view; --angle scene would refuse the lenses that cannot see as wide as the scene.
 # shellcheck disable=SC2086 # $defaults holds separate words without blanks or globs.
 set -- $defaults "$@"
 

@@ -36,6 +36,8 @@ static int setup_placement(camera *c, const camera_options *o, l2p_error *err)
                         "--sky must not be parallel to the viewing direction");
     c->right = v3_normalize(side);
     c->up = v3_cross(c->forward, c->right);
+    if (o->mirror)
+        c->right = v3_scale(c->right, -1.0);
     c->location = o->location;
     c->unit_mm = o->unit_mm;
     return L2P_OK;

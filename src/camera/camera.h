@@ -24,6 +24,7 @@ typedef struct camera_options {
     pupil_kind pupil;
     trace_kind trace;
     vec3 location, look_at, sky;
+    bool mirror;               /* right points left: the picture mirrored (a scene's camera) */
     double unit_mm;
     weighting weighting;
     uint64_t seed;

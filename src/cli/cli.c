@@ -143,8 +143,18 @@ static int film_option(cli *c, const char *opt, const char *v, l2p_error *err)
         return positive_int(opt, v, &o->height, err);
     if (!strcmp(opt, "--spp"))
         return positive_int(opt, v, &o->spp, err);
-    if (!strcmp(opt, "--film-diagonal"))
+    if (!strcmp(opt, "--film-diagonal")) {
+        c->diagonal_given = true;
         return positive_double(opt, v, &o->film_diagonal_mm, err);
+    }
+    if (!strcmp(opt, "--angle")) {   /* the film width: framing.c */
+        c->angle_scene = !strcmp(v, "scene");
+        if (c->angle_scene)
+            return L2P_OK;
+        if (!parse_double(v, &c->angle_deg) || !(c->angle_deg > 0.0 && c->angle_deg < 360.0))
+            return bad(err, opt, "degrees (more than 0, less than 360) or 'scene'", v);
+        return L2P_OK;
+    }
     if (!strcmp(opt, "--film-distance")) {
         if (!parse_double(v, &o->film_distance_mm) || o->film_distance_mm < 0.0)
             return bad(err, opt, "a distance in mm, 0 or more", v);
@@ -198,6 +208,7 @@ static int lens_option(cli *c, const char *opt, const char *v, l2p_error *err)
 static int place_option(cli *c, const char *opt, const char *v, l2p_error *err)
 {
     camera_options *o = &c->cam;
+    c->placed |= !strcmp(opt, "--location") || !strcmp(opt, "--look-at") || !strcmp(opt, "--sky");
     if (!strcmp(opt, "--location"))
         return parse_vec3(v, &o->location) ? 0 : bad(err, opt, "x,y,z", v);
     if (!strcmp(opt, "--look-at"))
@@ -220,6 +231,8 @@ static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
         c->rays_csv = v;
     else if (!strcmp(opt, "--keep-temp"))
         c->keep_temp = v;
+    else if (!strcmp(opt, "--scene"))
+        c->scene = v;
     else if (!strcmp(opt, "--jobs"))   /* outfile.c stops at most 256 children on a signal */
         return int_up_to(opt, v, JOBS_MOST, &c->jobs, err);
     else if (!strcmp(opt, "--memory-mb"))  /* up to 1 PiB: render converts it to a face count */
@@ -273,6 +286,9 @@ static int check_contradictions(const cli *c, l2p_error *err)
     if (!isnan(o->film_distance_mm) && !isnan(o->focus_distance_units))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--film-distance and --focus-distance both set the focus: give one");
+    if ((c->angle_scene || !isnan(c->angle_deg)) && c->diagonal_given)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--angle and --film-diagonal both set the film's size: give one");
     if (!isnan(o->aperture_diameter_mm) && !isnan(o->f_number))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--aperture-diameter and --f-number both set the aperture: give one");
@@ -298,6 +314,7 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
 {
     memset(c, 0, sizeof *c);
     camera_options_default(&c->cam);
+    c->angle_deg = NAN;
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         if (is_flag(c, a))

@@ -21,6 +21,11 @@ typedef struct cli {
     bool json;                   /* --json */
     bool quiet;                  /* --quiet: no progress bar */
     bool film_given;             /* any film or focus option was given (info prints more) */
+    bool placed;                 /* --location, --look-at or --sky: the scene's camera is not used */
+    const char *scene;           /* trace --scene: the scene whose camera places the lens */
+    double angle_deg;            /* --angle: the horizontal field of view; NAN: not given */
+    bool angle_scene;            /* --angle scene: the scene camera's */
+    bool diagonal_given;         /* --film-diagonal (it contradicts --angle) */
 } cli;
 
 /* Parses argv[first..argc-1]. */

@@ -42,7 +42,7 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
    fisheye's image circle) the field ends at the image circle: the film point is moved toward
    the centre, by bisection, to the last place its ray passes. NAN when even the centre's is
    blocked. */
-static double half_field_deg(const camera *c, vec3 p)
+double info_half_field_deg(const camera *c, vec3 p)
 {
     ray r;
     double w, in = 1.0, out = 1.0;
@@ -98,9 +98,9 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, 
             {"focus_distance", "focus distance (film to subject)", "units", c->focus_distance_units},
             {"working_f_number", "f-number (this aperture)", "", c->f_number},
             {"aperture_diameter_mm", "aperture diameter", "mm", c->lens.stop_diameter_mm},
-            {"hfov_deg", "horizontal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0, 0))},
-            {"vfov_deg", "vertical field of view", "deg", 2 * half_field_deg(c, v3(0, 0.5 * fi->height_mm, 0))},
-            {"dfov_deg", "diagonal field of view", "deg", 2 * half_field_deg(c, v3(0.5 * fi->width_mm, 0.5 * fi->height_mm, 0))},
+            {"hfov_deg", "horizontal field of view", "deg", 2 * info_half_field_deg(c, v3(0.5 * fi->width_mm, 0, 0))},
+            {"vfov_deg", "vertical field of view", "deg", 2 * info_half_field_deg(c, v3(0, 0.5 * fi->height_mm, 0))},
+            {"dfov_deg", "diagonal field of view", "deg", 2 * info_half_field_deg(c, v3(0.5 * fi->width_mm, 0.5 * fi->height_mm, 0))},
             /* Only where the lens passes nothing beyond it (a fisheye's image circle). */
             {"image_circle_mm", "image circle diameter", "mm",
              isfinite(c->pupil.reach_mm) ? 2.0 * c->pupil.reach_mm : NAN},

@@ -16,6 +16,11 @@ typedef struct lens_info {
 /* First-order properties of the lens at its full stop, independent of the film distance. */
 int lens_info_of(const lens *l, lens_info *out, l2p_error *err);
 
+/* Half field angle, degrees, of film point p: its ray through the middle of the pupil region
+   sampled for it, traced out of the lens; beyond a fisheye's image circle, the circle's. NAN
+   when even the centre's ray is blocked. */
+double info_half_field_deg(const camera *c, vec3 p);
+
 /* Prints them, and the camera's focus and field of view when c is not NULL. */
 void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, bool json);
 

@@ -5,6 +5,7 @@
 #include "camera/camera.h"
 #include "cli/cli.h"
 #include "image/develop.h"
+#include "cli/framing.h"
 #include "cli/info.h"
 #include "base/outfile.h"
 #include "raytable/raytable.h"
@@ -27,6 +28,8 @@ static const char camera_help[] =
     "  --width N --height N          film pixels [640 x 480]\n"
     "  --spp N                       samples per pixel [16]\n"
     "  --film-diagonal MM            [35]\n"
+    "  --angle DEG|scene             film width for this horizontal field of view, traced\n"
+    "                                (scene: the scene camera's angle) [--film-diagonal]\n"
     "  --crop X0,Y0,X1,Y1            a region of the film (X1, Y1 exclusive) [the whole film]\n"
     "  --film-distance MM | --focus-distance UNITS|inf\n"
     "                                [focus on the look-at point]\n"
@@ -35,6 +38,7 @@ static const char camera_help[] =
     "  --trace full|thick            [full]\n"
     "  --weighting normalized|physical   [normalized]\n"
     "  --location X,Y,Z [0,0,0]  --look-at X,Y,Z [0,0,1]  --sky X,Y,Z [0,1,0]\n"
+    "                                [render, trace --scene: the scene's camera]\n"
     "  --unit-mm MM                  millimetres in a scene unit [1000]\n"
     "  --seed N                      the sample pattern's seed [0]\n";
 
@@ -51,6 +55,7 @@ static const struct {
               "Traces the film into PREFIX.inc (mesh_camera), PREFIX.ini and PREFIX.map.\n"
               "  -o, --output PREFIX           (required)\n"
               "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"
+              "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"
               "  --memory-mb MB                split into chunks that fit a POV-Ray process of\n"
               "                                this size [one include]\n"
               "  -q, --quiet                   no progress or summary on stderr\n", true},
@@ -106,7 +111,7 @@ static int load_camera(const cli *c, const char *lens_path, camera *cam, l2p_err
     int st = lens_read(lens_path, &l, err);
     if (st)
         return st;
-    st = camera_setup(cam, &l, &c->cam, err);
+    st = framing_camera_setup(cam, &l, c, err);
     if (st)
         camera_free(cam);
     return st;
@@ -124,7 +129,7 @@ static int cmd_info(const cli *c, l2p_error *err)
     if (!(st = lens_info_of(&l, &li, err)) && with_camera) {
         lens copy;
         st = lens_copy(&copy, &l) ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
-                                  : camera_setup(&cam, &copy, &c->cam, err);
+                                  : framing_camera_setup(&cam, &copy, c, err);
         if (st)
             camera_free(&cam);
     }
@@ -152,11 +157,14 @@ static int check_trace_outputs(const cli *c, l2p_error *err)
     return st;
 }
 
-static int cmd_trace(const cli *c, l2p_error *err)
+static int cmd_trace(const cli *given, l2p_error *err)
 {
     camera cam;
+    cli placed = *given;   /* with --scene's camera placement */
+    const cli *c = &placed;
     int st = need(c, 1, true, err);
     if (st || (st = check_trace_outputs(c, err)) ||
+        (c->scene && (st = framing_from_scene(&placed, c->scene, err))) ||
         (st = load_camera(c, c->positional[0], &cam, err)))
         return st;
     cli_warn(c, &cam);

@@ -12,6 +12,7 @@
 #include <unistd.h>
 #include "base/cores.h"
 #include "camera/camera.h"
+#include "cli/framing.h"
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "base/outfile.h"
@@ -315,16 +316,19 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     return st;
 }
 
-int render_command(const cli *c, l2p_error *err)
+int render_command(const cli *given, l2p_error *err)
 {
-    int st = check_inputs(c, err);
+    int st = check_inputs(given, err);
     if (st)
         return st;
+    cli placed = *given;   /* with the scene camera's placement */
+    const cli *c = &placed;
     lens l;
-    if ((st = lens_read(c->positional[1], &l, err)))
+    if ((st = framing_from_scene(&placed, c->positional[0], err)) ||
+        (st = lens_read(c->positional[1], &l, err)))
         return st;
     camera cam;
-    if ((st = camera_setup(&cam, &l, &c->cam, err))) {
+    if ((st = framing_camera_setup(&cam, &l, c, err))) {
         camera_free(&cam);
         return st;
     }

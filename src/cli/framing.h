@@ -1,0 +1,22 @@
+/* Where the lens stands and how much it sees: the scene's camera for the placement when no
+   --location, --look-at or --sky is given, and the film width for --angle. */
+#ifndef LENS2POV_FRAMING_H
+#define LENS2POV_FRAMING_H
+
+#include "camera/camera.h"
+#include "cli/cli.h"
+#include "base/error.h"
+
+/* Reads the scene's camera (src/povray/scenecam.h) when the placement or --angle scene needs
+   it, and sets c->cam from it: the lens at the camera's location, looking along its
+   direction, its film up along the camera's up, mirrored when the camera's right is, focused
+   on the look_at point. */
+int framing_from_scene(cli *c, const char *scene, l2p_error *err);
+
+
+
+/* camera_setup for the command line: with --angle, the film diagonal that makes the lens's
+   horizontal field of view, traced with real rays at the focus in effect, the angle asked
+   (the film keeps its aspect); L2P_BAD_INPUT when the lens cannot reach it. Takes the lens. */
+int framing_camera_setup(camera *cam, lens *l, const cli *c, l2p_error *err);
+#endif

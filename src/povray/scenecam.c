@@ -1,0 +1,485 @@
+/* The scene's camera: POV-Ray parses a copy of the scene whose camera statements print their
+   items (scenecam_text.c); here the copy is run and POV-Ray 3.7's camera rules are applied to
+   the items of the last statement that ran. */
+#include "povray/scenecam.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "base/outfile.h"
+#include "povray/povray_log.h"
+
+/* POV-Ray's EPSILON in the camera code. */
+#define POV_EPSILON 1e-10
+/* Cosine between two camera vectors above which lens2pov calls them skewed. */
+#define SKEW_COS 1e-6
+
+/* ---------------------------------------------------------------- the items, as POV-Ray's rules */
+
+typedef struct affine { vec3 o, ex, ey, ez; } affine;   /* images of 0, x, y, z */
+
+static vec3 affine_dir(const affine *m, vec3 d)
+{
+    return v3(d.x * (m->ex.x - m->o.x) + d.y * (m->ey.x - m->o.x) + d.z * (m->ez.x - m->o.x),
+              d.x * (m->ex.y - m->o.y) + d.y * (m->ey.y - m->o.y) + d.z * (m->ez.y - m->o.y),
+              d.x * (m->ex.z - m->o.z) + d.y * (m->ey.z - m->o.z) + d.z * (m->ez.z - m->o.z));
+}
+
+static vec3 affine_point(const affine *m, vec3 p) { return v3_add(m->o, affine_dir(m, p)); }
+
+/* b after a. */
+static affine affine_then(const affine *a, const affine *b)
+{
+    affine r;
+    r.o = affine_point(b, a->o);
+    r.ex = affine_point(b, a->ex);
+    r.ey = affine_point(b, a->ey);
+    r.ez = affine_point(b, a->ez);
+    return r;
+}
+
+typedef struct pov_camera {
+    char type[32];
+    vec3 location, direction, up, right, sky, look_at, focus;
+    double angle;
+    bool has_look_at, has_angle, declared, unsupported;
+    affine trans, pending;     /* the transforms so far; the one being read */
+    double version;
+} pov_camera;
+
+static void pov_camera_default(pov_camera *c)
+{
+    memset(c, 0, sizeof *c);
+    strcpy(c->type, "perspective");
+    c->direction = v3(0, 0, 1);
+    c->up = v3(0, 1, 0);
+    c->right = v3(1.33, 0, 0);
+    c->sky = v3(0, 1, 0);
+    c->trans = (affine){v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), v3(0, 0, 1)};
+    c->version = 3.7;
+}
+
+static void apply_transform(pov_camera *c, const affine *m)
+{
+    c->location = affine_point(m, c->location);
+    c->focus = affine_point(m, c->focus);
+    c->direction = affine_dir(m, c->direction);
+    c->up = affine_dir(m, c->up);
+    c->right = affine_dir(m, c->right);
+}
+
+static void apply_angle(pov_camera *c)
+{
+    if (strcmp(c->type, "perspective") || !(c->angle > 0.0))
+        return;
+    c->direction = v3_scale(v3_normalize(c->direction),
+                            v3_length(c->right) / tan(c->angle * M_PI / 360.0) / 2.0);
+}
+
+/* look_at keeps the lengths of direction, up and right and the handedness of the three. */
+static int apply_look_at(pov_camera *c, const char *scene, int line, l2p_error *err)
+{
+    const double dl = v3_length(c->direction), ul = v3_length(c->up), rl = v3_length(c->right);
+    const double hand = v3_dot(v3_cross(c->up, c->direction), c->right);
+    vec3 d = v3_sub(c->look_at, c->location);
+    if (v3_dot(d, d) < POV_EPSILON)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, line,
+                        "the camera's location and look_at are the same point");
+    d = v3_normalize(d);
+    vec3 r = v3_cross(c->sky, d);
+    if (fabs(r.x) < POV_EPSILON && fabs(r.y) < POV_EPSILON && fabs(r.z) < POV_EPSILON)
+        r = c->right;
+    r = v3_normalize(r);
+    c->up = v3_scale(v3_cross(d, r), ul);
+    c->direction = v3_scale(d, dl);
+    c->right = v3_scale(r, hand > 0.0 ? rl : -rl);
+    c->focus = c->look_at;
+    return L2P_OK;
+}
+
+/* ---------------------------------------------------------------- reading the #debug lines */
+
+/* The next message "lens2pov-WORD rest|" at or after *pos: its lines joined (POV-Ray wraps
+   its console at 80 columns, at a blank kept on the next line or inside a word), into buf. */
+static bool next_message(const char *log, size_t n, size_t *pos, char *buf, size_t cap)
+{
+    size_t i = *pos;
+    while (i < n) {
+        const bool at_line = i == 0 || log[i - 1] == '\n';
+        if (at_line && n - i >= 9 && !memcmp(log + i, "lens2pov-", 9)) {
+            size_t k = 0;
+            for (; i < n && log[i] != '|'; i++)
+                if (log[i] != '\n' && log[i] != '\r' && k + 1 < cap)
+                    buf[k++] = log[i];
+            buf[k] = '\0';
+            *pos = i < n ? i + 1 : n;
+            return i < n;
+        }
+        const char *nl = memchr(log + i, '\n', n - i);
+        i = nl ? (size_t)(nl - log) + 1 : n;
+    }
+    *pos = n;
+    return false;
+}
+
+static bool read_numbers(const char *s, double *v, int count)
+{
+    for (int k = 0; k < count; k++) {
+        char *end;
+        v[k] = strtod(s, &end);
+        if (end == s || !isfinite(v[k]))
+            return false;
+        s = end;
+    }
+    return true;
+}
+
+/* One item message into the camera; false when it cannot be read. The old syntax (before
+   #version 3.5) applies each item at once, the new one at the end (finish_camera). */
+static bool take_item(pov_camera *c, const char *msg, const char *scene, int line, int *st,
+                      l2p_error *err)
+{
+    char word[32];
+    int used = 0;
+    if (sscanf(msg, "lens2pov-%31s %n", word, &used) < 1)
+        return false;
+    const char *rest = msg + used;
+    const bool old = c->version < 3.5;
+    double v[12];
+    if (!strcmp(word, "version"))
+        return read_numbers(rest, &c->version, 1);
+    if (!strcmp(word, "type"))
+        return sscanf(rest, "%31s", c->type) == 1;
+    if (!strcmp(word, "declared"))
+        return c->declared = true;
+    if (!strcmp(word, "directive") || !strcmp(word, "unknown"))
+        return c->unsupported = true;
+    if (!strcmp(word, "angle")) {
+        if (!read_numbers(rest, &c->angle, 1))
+            return false;
+        c->has_angle = true;
+        if (old)
+            apply_angle(c);
+        return true;
+    }
+    /* A transform: its images of the origin and of x, y and z, one a message. */
+    if (word[0] == 't' && word[1] >= '0' && word[1] <= '3' && !word[2]) {
+        vec3 *slot[4] = {&c->pending.o, &c->pending.ex, &c->pending.ey, &c->pending.ez};
+        if (!read_numbers(rest, v, 3))
+            return false;
+        *slot[word[1] - '0'] = v3(v[0], v[1], v[2]);
+        if (word[1] != '3')
+            return true;
+        if (old)
+            apply_transform(c, &c->pending);
+        else
+            c->trans = affine_then(&c->trans, &c->pending);
+        return true;
+    }
+    if (!read_numbers(rest, v, 3))
+        return false;
+    const vec3 x = v3(v[0], v[1], v[2]);
+    if (!strcmp(word, "location"))
+        c->location = x;
+    else if (!strcmp(word, "direction"))
+        c->direction = x;
+    else if (!strcmp(word, "up"))
+        c->up = x;
+    else if (!strcmp(word, "right"))
+        c->right = x;
+    else if (!strcmp(word, "sky"))
+        c->sky = x;
+    else if (!strcmp(word, "look_at")) {
+        c->look_at = x;
+        c->has_look_at = true;
+        if (old)
+            *st = apply_look_at(c, scene, line, err);
+    } else
+        return false;
+    return true;
+}
+
+/* The new syntax's fixed order: angle, look_at, then the transforms. */
+static int finish_camera(pov_camera *c, const char *scene, int line, l2p_error *err)
+{
+    if (c->version < 3.5)
+        return L2P_OK;
+    if (c->has_angle && !strcmp(c->type, "perspective") && c->angle >= 180.0)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, line,
+                        "the camera's angle must be smaller than 180 degrees");
+    if (c->has_angle)
+        apply_angle(c);
+    if (c->has_look_at) {
+        const int st = apply_look_at(c, scene, line, err);
+        if (st)
+            return st;
+    }
+    apply_transform(c, &c->trans);
+    return L2P_OK;
+}
+
+static int refuse(l2p_error *err, const char *scene, int line, const char *why)
+{
+    return l2p_fail(err, L2P_BAD_INPUT, scene, line,
+                    "%s: lens2pov cannot stand in for this camera; give --location and "
+                    "--look-at (and --sky, --angle) instead", why);
+}
+
+/* The lens camera for POV-Ray's: perspective, with right, up and direction perpendicular. */
+static int to_scene_camera(const pov_camera *c, const char *scene, int line, scene_camera *out,
+                           l2p_error *err)
+{
+    char why[128];
+    if (c->declared)
+        return refuse(err, scene, line, "the camera starts from a declared camera");
+    if (c->unsupported)
+        return refuse(err, scene, line, "the camera block holds a directive or an unknown word");
+    if (strcmp(c->type, "perspective")) {
+        snprintf(why, sizeof why, "the camera is %s, not perspective", c->type);
+        return refuse(err, scene, line, why);
+    }
+    const double dl = v3_length(c->direction), ul = v3_length(c->up), rl = v3_length(c->right);
+    if (!(dl > 0.0 && ul > 0.0 && rl > 0.0) || !v3_isfinite(c->location) ||
+        !isfinite(dl * ul * rl))
+        return refuse(err, scene, line, "the camera has a zero or non-finite direction, up or right");
+    const vec3 d = v3_scale(c->direction, 1.0 / dl), u = v3_scale(c->up, 1.0 / ul),
+               r = v3_scale(c->right, 1.0 / rl);
+    if (fabs(v3_dot(d, u)) > SKEW_COS || fabs(v3_dot(d, r)) > SKEW_COS ||
+        fabs(v3_dot(u, r)) > SKEW_COS)
+        return refuse(err, scene, line, "the camera's direction, up and right are not perpendicular");
+    out->location = c->location;
+    out->forward = d;
+    /* up made exactly perpendicular to forward: lens2pov builds right from it */
+    out->up = v3_normalize(v3_sub(u, v3_scale(d, v3_dot(u, d))));
+    out->mirrored = v3_dot(v3_cross(u, d), r) < 0.0;
+    const double focus = v3_dot(v3_sub(c->focus, c->location), d);
+    out->focus_distance = c->has_look_at && focus > 0.0 && isfinite(focus) ? focus : dl;
+    out->hfov_deg = 2.0 * atan(0.5 * rl / dl) * 180.0 / M_PI;
+    out->found = true;
+    out->line = line;
+    return L2P_OK;
+}
+
+int scene_camera_from_log(const char *log, size_t n, const char *scene, scene_camera *out,
+                          l2p_error *err)
+{
+    /* The last statement that ran: it replaces every earlier one entirely (POV-Ray 3.7 starts
+       each camera statement from the default camera). */
+    size_t pos = 0, last = n;
+    char buf[4096];
+    int index, line = 0;
+    for (size_t at = 0; next_message(log, n, &pos, buf, sizeof buf); at = pos)
+        if (sscanf(buf, "lens2pov-camera %d %d", &index, &line) == 2)
+            last = at;
+    memset(out, 0, sizeof *out);
+    if (last == n) {   /* POV-Ray's default camera */
+        pov_camera c;
+        pov_camera_default(&c);
+        c.focus = v3(0, 0, 1);
+        int st = to_scene_camera(&c, scene, 0, out, err);
+        out->found = false;
+        return st;
+    }
+    pos = last;
+    next_message(log, n, &pos, buf, sizeof buf);
+    sscanf(buf, "lens2pov-camera %d %d", &index, &line);
+    pov_camera c;
+    pov_camera_default(&c);
+    int st = L2P_OK;
+    while (!st && next_message(log, n, &pos, buf, sizeof buf) && strcmp(buf, "lens2pov-end")) {
+        if (!take_item(&c, buf, scene, line, &st, err) && !st)
+            st = l2p_fail(err, L2P_FAILED, scene, line, "cannot read POV-Ray's value: %s", buf);
+    }
+    if (!c.has_look_at)
+        c.focus = v3_add(c.location, c.direction);   /* before the transforms */
+    if (!st)
+        st = finish_camera(&c, scene, line, err);
+    return st ? st : to_scene_camera(&c, scene, line, out, err);
+}
+
+/* ---------------------------------------------------------------- running POV-Ray on the copy */
+
+static char *read_all(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    for (size_t got; buf && (got = fread(buf + len, 1, cap - len, f)) > 0;) {
+        len += got;
+        char *grown = len == cap ? realloc(buf, cap *= 2) : buf;
+        if (!grown)
+            free(buf);
+        buf = grown;
+    }
+    fclose(f);
+    if (buf)
+        *n = len;
+    return buf;
+}
+
+static int write_all(const char *path, const char *s, l2p_error *err)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    const bool ok = fwrite(s, 1, strlen(s), f) == strlen(s);
+    if (fclose(f) != 0 || !ok)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    return L2P_OK;
+}
+
+static bool plain_path(const char *p)
+{
+    for (; *p; p++)
+        if (*p < 0x20 || *p > 0x7e || *p == '"' || *p == '\\')
+            return false;
+    return true;
+}
+
+/* POV-Ray parses the copy in the scene's folder, as the render will run it: the same
+   povray.ini, the same includes. One pixel is traced; the parse is what counts. */
+static int run_probe(const char *dir, const char *copy, const char *log, int w, int h,
+                     l2p_error *err)
+{
+    const char *exe = getenv("LENS2POV_POVRAY");
+    exe = exe && *exe ? exe : "povray";
+    char in[4300], size_w[32], size_h[32], rows[64], cols[64];
+    snprintf(in, sizeof in, "+I\"%s\"", copy);
+    snprintf(size_w, sizeof size_w, "+W%d", w);
+    snprintf(size_h, sizeof size_h, "+H%d", h);
+    /* +SR2: a whole number above 1 is a pixel, 1 itself the fraction 1.0 */
+    snprintf(rows, sizeof rows, "+SR%d", h > 1 ? 2 : 1);
+    snprintf(cols, sizeof cols, "+SC%d", w > 1 ? 2 : 1);
+    char end_rows[64], end_cols[64];
+    snprintf(end_rows, sizeof end_rows, "+ER%d", h > 1 ? 2 : 1);
+    snprintf(end_cols, sizeof end_cols, "+EC%d", w > 1 ? 2 : 1);
+    char *argv[] = {(char *)exe, in, size_w, size_h, rows, end_rows, cols, end_cols, "-F", "-D",
+                    "-P", "-C", "-A", "-GS", "-GR", "+GD", NULL};
+    const int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0)
+        return l2p_fail(err, L2P_FAILED, log, 0, "cannot write: %s", strerror(errno));
+    sigset_t old;
+    outfile_block_signals(&old);
+    const pid_t pid = fork();
+    if (pid == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGTERM);   /* gone with lens2pov, however it ends */
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        signal(SIGHUP, SIG_DFL);
+        sigprocmask(SIG_SETMASK, &old, NULL);
+        const int null_fd = open("/dev/null", O_RDONLY);
+        if (null_fd >= 0)
+            dup2(null_fd, STDIN_FILENO);
+        dup2(fd, STDOUT_FILENO);
+        dup2(fd, STDERR_FILENO);
+        if (chdir(dir) == 0)
+            execvp(exe, argv);
+        _exit(127);
+    }
+    if (pid > 0)
+        outfile_track_child(pid);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    close(fd);
+    if (pid < 0)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
+    int status;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    outfile_untrack_child(pid);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "%s: cannot run it (install Debian's povray "
+                        "package) or cannot enter %s", exe, dir);
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? L2P_OK : -1;
+}
+
+static char *folder_of(const char *path)
+{
+    char *abs = NULL;
+    if (path[0] == '/') {
+        abs = strdup(path);
+    } else {
+        char cwd[4096];
+        if (getcwd(cwd, sizeof cwd) && (abs = malloc(strlen(cwd) + strlen(path) + 2)))
+            sprintf(abs, "%s/%s", cwd, path);
+    }
+    char *slash = abs ? strrchr(abs, '/') : NULL;
+    if (slash)
+        slash[slash == abs ? 1 : 0] = '\0';
+    return abs;
+}
+
+static int probe(const char *scene, const char *dir, const char *work, int w, int h,
+                 scene_camera *out, l2p_error *err)
+{
+    char copy[4200], log[4200];
+    snprintf(copy, sizeof copy, "%s/scene-camera.pov", work);
+    snprintf(log, sizeof log, "%s/scene-camera.log", work);
+    size_t n = 0;
+    char *text = read_all(scene, &n);
+    if (!text)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
+    char *rewritten = memchr(text, '\0', n) ? NULL : scene_camera_rewrite(text, n);
+    const bool no_camera = rewritten && !strcmp(rewritten, text);
+    free(text);
+    if (!rewritten)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file (or out of memory)");
+    if (no_camera) {   /* POV-Ray's default camera: nothing for POV-Ray to evaluate */
+        free(rewritten);
+        return scene_camera_from_log("", 0, scene, out, err);
+    }
+    int st = write_all(copy, rewritten, err);
+    free(rewritten);
+    if (!st) {
+        st = run_probe(dir, copy, log, w, h, err);
+        if (st < 0) {   /* POV-Ray's own error, in the user's file */
+            const povray_path_link link = {copy, (char *)scene};
+            const povray_log_names names = {scene, dir, {NULL, NULL}, &link, 1};
+            if (!povray_log_error(log, &names, err))
+                l2p_fail(err, L2P_FAILED, scene, 0, "POV-Ray failed reading the scene's camera");
+            st = L2P_FAILED;
+        }
+    }
+    char *out_log = st ? NULL : read_all(log, &n);
+    if (!st && !out_log)
+        st = l2p_fail(err, L2P_FAILED, log, 0, "cannot read: %s", strerror(errno));
+    if (!st)
+        st = scene_camera_from_log(out_log, n, scene, out, err);
+    free(out_log);
+    unlink(copy);
+    unlink(log);
+    return st;
+}
+
+int scene_camera_read(const char *scene, int width, int height, scene_camera *out,
+                      l2p_error *err)
+{
+    if (access(scene, R_OK) != 0)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
+    const char *tmp = getenv("TMPDIR");
+    char work[4096];
+    snprintf(work, sizeof work, "%s/lens2pov-camera.XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    if (!plain_path(work))
+        snprintf(work, sizeof work, "/tmp/lens2pov-camera.XXXXXX");
+    if (!mkdtemp(work))
+        return l2p_fail(err, L2P_FAILED, work, 0, "cannot make a temporary folder: %s",
+                        strerror(errno));
+    outfile_track(work);
+    char *dir = folder_of(scene);
+    const int st = dir ? probe(scene, dir, work, width, height, out, err)
+                       : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    free(dir);
+    rmdir(work);
+    outfile_untrack(work);
+    return st;
+}

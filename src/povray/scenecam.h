@@ -1,0 +1,40 @@
+/* The camera a scene ends with, as POV-Ray evaluates it. POV-Ray 3.7 cannot print a camera, so
+   lens2pov copies the scene with every `camera { ... }` statement replaced by #debug lines that
+   print the statement's items (each vector, angle and transform evaluated by POV-Ray where the
+   statement stands), lets POV-Ray parse the copy, and applies POV-Ray's own camera rules
+   (parser.cpp, Parse_Camera) to the items of the last statement that ran
+   (docs/povray.md, "The scene's camera"). */
+#ifndef LENS2POV_SCENECAM_H
+#define LENS2POV_SCENECAM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include "base/error.h"
+#include "base/vec3.h"
+
+typedef struct scene_camera {
+    vec3 location;
+    vec3 forward, up;          /* unit, perpendicular */
+    bool mirrored;             /* right points against up x direction: the picture is mirrored */
+    double focus_distance;     /* along forward to the look_at point (else |direction|) */
+    double hfov_deg;           /* horizontal angle: 2 atan(|right| / (2 |direction|)) */
+    bool found;                /* false: no camera statement ran, POV-Ray's default camera */
+    int line;                  /* the statement's line in the scene (0 when not found) */
+} scene_camera;
+
+/* Runs POV-Ray on a copy of the scene at width x height (image_width and image_height read so)
+   and gives the camera it ends with. L2P_BAD_INPUT, naming the scene and line, for a camera
+   lens2pov cannot stand in for; L2P_FAILED with POV-Ray's error when the scene fails. */
+int scene_camera_read(const char *scene_path, int width, int height, scene_camera *out,
+                      l2p_error *err);
+
+/* The copy's text: every camera statement of text replaced by its #debug lines, on as many
+   lines as the statement took, so that POV-Ray's messages keep their line numbers. */
+char *scene_camera_rewrite(const char *text, size_t n);
+
+/* The camera from the #debug lines of POV-Ray's output (log, n bytes); scene names the scene
+   in messages. */
+int scene_camera_from_log(const char *log, size_t n, const char *scene, scene_camera *out,
+                          l2p_error *err);
+
+#endif

@@ -1,0 +1,203 @@
+/* The scene's own camera (issue 13): with no --location, --look-at or --sky, render and
+   trace --scene place the lens where the scene's last camera statement puts POV-Ray's camera,
+   as POV-Ray evaluates it; --angle scene takes its horizontal angle. Markers (small emitting
+   spheres, one colour each) must land where POV-Ray's own camera puts them. Pictures are
+   64x48 at 4 samples a pixel. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include "image/image_io.h"
+#include "povray/scenecam.h"
+#include "support.h"
+
+#define DGAUSS LENS_DIR "dgauss.50mm.dat"
+#define L2P(out, errtext, ...) run_lens2pov(out, errtext, __VA_ARGS__, (char *)NULL)
+#define SIZE "--width", "64", "--height", "48"
+
+/* The camera uses #declared vectors, an expression, a macro, angle and image_width. */
+#define MARKERS_HEAD                                                                            \
+    "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"                                    \
+    "#declare Eye = <1, 1.5, -4>;\n#declare Target = <0.2, 0.5, 0>;\n"                         \
+    "#macro Lift(V) (V + <0, 0.5, 0> * 2) #end\n"                                               \
+    "#macro Marker(P, C) sphere { P, 0.06 pigment { rgb C }\n"                                  \
+    "    finish { ambient 0 emission 1 diffuse 0 } } #end\n"                                   \
+    "Marker(Target, <1, 0, 0>)\nMarker(Target + <0.8, 0, 0>, <0, 1, 0>)\n"                      \
+    "Marker(Target + <0, 0.6, 0.3>, <0, 0, 1>)\n"
+
+#define CAMERA(right)                                                                           \
+    "camera {\n  location Lift(Eye) // where it stands\n  look_at Target\n  angle 40\n"        \
+    "  right " right " * image_width / image_height\n}\n"
+
+typedef struct centroid { double x, y; bool found; } centroid;
+
+/* Where channel c dominates: the weighted centre, in pixels (0, 0 the top-left corner). */
+static centroid marker(const char *path, int c)
+{
+    int w, h;
+    float *p;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(path, &w, &h, &p, &err), 0, "%s: %s", path, err.text);
+    double sx = 0, sy = 0, s = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *q = p + 4 * ((size_t)y * (size_t)w + (size_t)x);
+            const double v = q[c], others = q[0] + q[1] + q[2] - q[c];
+            if (v > 0.05 && v > 2 * others) {
+                sx += v * (x + 0.5);
+                sy += v * (y + 0.5);
+                s += v;
+            }
+        }
+    free(p);
+    return (centroid){s > 0 ? sx / s : NAN, s > 0 ? sy / s : NAN, s > 0};
+}
+
+static void povray_render(const char *dir, const char *scene, const char *out)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && povray +I%s +O%s +W64 +H48 +FN -A -D -V -GA >povray.log 2>&1", dir,
+             scene, out);
+    cr_assert_eq(system(cmd), 0, "%s", cmd);
+}
+
+/* The scene through the lens, with no placement and --angle scene, against POV-Ray's camera. */
+static void expect_markers_as_povray(const char *scene_text)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], own[512], lens[512];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(own, sizeof own, "%s/own.png", dir);
+    snprintf(lens, sizeof lens, "%s/lens.png", dir);
+    write_text(scene, scene_text);
+    povray_render(dir, "scene.pov", "own.png");
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "4", "--angle",
+                       "scene", "--jobs", "1", "-q", "-o", lens);
+    cr_assert_eq(st, 0, "render failed: %s", errtext ? errtext : "");
+    free(errtext);
+    for (int c = 0; c < 3; c++) {
+        const centroid a = marker(own, c), b = marker(lens, c);
+        cr_assert(a.found && b.found, "marker %d missing (POV-Ray %d, lens %d)", c, a.found, b.found);
+        cr_log_info("marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", c, a.x, a.y, b.x, b.y);
+        /* The lens has a little distortion and depth of field; a pixel is the tolerance. */
+        cr_expect(fabs(a.x - b.x) < 1.0 && fabs(a.y - b.y) < 1.0,
+                  "marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", c, a.x, a.y, b.x, b.y);
+    }
+}
+
+Test(scene_camera, declared_vectors_expression_and_angle)
+{
+    expect_markers_as_povray(MARKERS_HEAD CAMERA("x"));
+}
+
+Test(scene_camera, mirrored_right_mirrors_the_picture)
+{
+    expect_markers_as_povray(MARKERS_HEAD CAMERA("-x"));
+}
+
+/* Transforms after look_at, an earlier camera that the last one replaces, and a camera in an
+   #if branch that does not run. */
+Test(scene_camera, transforms_and_the_last_camera)
+{
+    expect_markers_as_povray(MARKERS_HEAD
+                             "camera { location <5, 5, 5> look_at 0 angle 80 }\n"
+                             "#if (clock > 1) camera { location <9, 9, 9> look_at 0 } #end\n"
+                             "camera { location Lift(Eye) - Target look_at 0 angle 40\n"
+                             "  rotate <0, 5, 0> translate Target }\n");
+}
+
+Test(scene_camera, orthographic_is_refused)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], out[512];
+    snprintf(scene, sizeof scene, "%s/ortho.pov", dir);
+    snprintf(out, sizeof out, "%s/out.png", dir);
+    write_text(scene, MARKERS_HEAD "camera { orthographic location <0, 1, -4> look_at 0 }\n");
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
+    cr_expect_eq(st, 2);
+    cr_expect(errtext && strstr(errtext, scene) && strstr(errtext, "orthographic"), "%s",
+              errtext ? errtext : "");
+    struct stat sb;
+    cr_expect(stat(out, &sb) != 0, "an output was written");
+    free(errtext);
+}
+
+/* Explicit placement wins: trace --scene with --location and --look-at writes what trace
+   without the scene writes. */
+Test(scene_camera, explicit_placement_overrides_the_scene)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], a[512], b[512], ainc[520], binc[520];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(a, sizeof a, "%s/a", dir);
+    snprintf(b, sizeof b, "%s/b", dir);
+    snprintf(ainc, sizeof ainc, "%s.inc", a);
+    snprintf(binc, sizeof binc, "%s.inc", b);
+    write_text(scene, MARKERS_HEAD CAMERA("x"));
+    cr_assert_eq(L2P(NULL, NULL, "trace", DGAUSS, SIZE, "--spp", "1", "--scene", scene,
+                     "--location", "0,1,-3", "--look-at", "0,0.5,0", "-q", "-o", a), 0);
+    cr_assert_eq(L2P(NULL, NULL, "trace", DGAUSS, SIZE, "--spp", "1", "--location", "0,1,-3",
+                     "--look-at", "0,0.5,0", "-q", "-o", b), 0);
+    size_t na, nb;
+    char *ta = read_text(ainc, &na), *tb = read_text(binc, &nb);
+    cr_assert(ta && tb);
+    cr_expect(na == nb && !memcmp(ta, tb, na), "the scene's camera changed an explicit placement");
+    free(ta);
+    free(tb);
+}
+
+/* --angle DEG: the traced horizontal field of view is DEG; an angle out of reach is refused. */
+Test(scene_camera, angle_sets_the_traced_field_of_view)
+{
+    char *out = NULL;
+    cr_assert_eq(L2P(&out, NULL, "info", DGAUSS, "--angle", "40", "--focus-distance", "inf", "--json"), 0);
+    const char *p = out ? strstr(out, "\"hfov_deg\":") : NULL;
+    cr_assert_not_null(p, "%s", out ? out : "");
+    cr_expect(fabs(strtod(p + 11, NULL) - 40.0) < 1e-6, "%s", p);
+    free(out);
+    char *errtext = NULL;
+    cr_expect_eq(L2P(NULL, &errtext, "info", LENS_DIR "telephoto.250mm.dat", "--angle", "60", "--focus-distance", "inf"), 2);
+    cr_expect(errtext && strstr(errtext, "--angle"), "%s", errtext ? errtext : "");
+    free(errtext);
+}
+
+/* The copy keeps every line where it was, so POV-Ray's messages name the scene's lines. */
+Test(scene_camera, rewrite_keeps_lines)
+{
+    const char *text = "#declare A = camera { location 1 }\n"
+                       "camera {\n location <0, 1, -3> // a } comment\n"
+                       " look_at /* nested /* } */ */ 0\n}\nsphere { 0, 1 }\n\"camera {\"\n";
+    char *copy = scene_camera_rewrite(text, strlen(text));
+    cr_assert_not_null(copy);
+    int a = 0, b = 0;
+    for (const char *p = text; *p; p++)
+        a += *p == '\n';
+    for (const char *p = copy; *p; p++)
+        b += *p == '\n';
+    cr_expect_eq(a, b, "%s", copy);
+    cr_expect(strstr(copy, "#declare A = camera { location 1 }"), "%s", copy);
+    cr_expect(strstr(copy, "sphere { 0, 1 }\n\"camera {\""), "%s", copy);
+    cr_expect(strstr(copy, "lens2pov-look_at"), "%s", copy);
+    free(copy);
+}
+
+/* POV-Ray wraps its console at 80 columns; the messages are joined again. */
+Test(scene_camera, wrapped_messages)
+{
+    const char *log = "noise\n\nlens2pov-camera 0 7|\n\nlens2pov-version 3.700|\n"
+                      "\nlens2pov-location 1.00000000000000000 2.000000000000000\n"
+                      "00 -3.00000000000000000|\n\nlens2pov-look_at 1.0 2.0 0.0|\n"
+                      "\nlens2pov-end|\n";
+    scene_camera sc;
+    l2p_error err;
+    cr_assert_eq(scene_camera_from_log(log, strlen(log), "s.pov", &sc, &err), 0, "%s", err.text);
+    cr_expect(sc.found && sc.line == 7);
+    cr_expect(fabs(sc.location.y - 2.0) < 1e-15 && fabs(sc.location.z + 3.0) < 1e-15);
+    cr_expect(fabs(sc.forward.z - 1.0) < 1e-15 && fabs(sc.focus_distance - 3.0) < 1e-12);
+    cr_expect(fabs(sc.hfov_deg - 2.0 * atan(0.665) * 180.0 / M_PI) < 1e-9);
+}
