@@ -1,6 +1,6 @@
 // Images through OpenImageIO 2.4, which has only a C++ API: the rest of lens2pov is C and calls
 // the extern "C" functions of image_io.h. This file alone is built into lens2pov-image-io.so,
-// which image_io_loader.c loads on first use (OpenImageIO's libraries cost 0.3 s at start-up);
+// which image_io_loader.c loads on first use (OpenImageIO's libraries are slow to load);
 // the .so exports those functions as image_io_impl_* (image_io_impl.h). No exception may cross
 // into C, so every entry point catches everything and turns it into an l2p_error.
 //

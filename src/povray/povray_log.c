@@ -8,8 +8,9 @@
 #include <unistd.h>
 
 enum {
-    TOKENS_PER_FACE = 23,      /* "Parsing NK tokens" per face of a lens2pov ray table: 29 measured
-                                  with 3 vertices a face, 8 tokens a vertex or face; 2.1 now */
+    TOKENS_PER_FACE = 23,      /* of "Parsing NK tokens", for the parse's progress: 8 tokens
+                                  (< x , y , z > ,) for a face's indices and for each of its
+                                  vertices, of which neighbours on a shared edge have two */
     PROGRESS_TAIL = 256,       /* bytes of a log read for the latest status line */
     ERROR_TAIL = 65536,        /* bytes of a failed log searched for POV-Ray's messages */
     MAX_MESSAGES = 64

@@ -18,10 +18,9 @@ void povface_single(vec3 o, vec3 d, double size, vec3 v[3]);
    origin as centroid and its direction as normal, exactly in real arithmetic. Returns false
    (v untouched) when float32 vertices would spoil the pair: rays nearly parallel, whose shared
    edge lies far away, or a ray close to the edge. A pair is coarser than two lone triangles of
-   circumradius size, within bounds: float32 moves its origins by at most 1.3e-5 of size
-   (measured worst of 2 million random pairs 3.6e-6; lone triangles 3e-8) and its directions
-   by a few 1e-7 rad (measured 2.5e-7; lone 3e-8). The coordinates are relative to the mesh's
-   origin, and non-finite input is refused. */
+   circumradius size, within bounds: float32 moves its origins by at most 1.3e-5 of size and
+   its directions by a few 1e-7 rad (docs/povray.md). The coordinates are relative to the
+   mesh's origin, and non-finite input is refused. */
 bool povface_pair(vec3 o1, vec3 d1, vec3 o2, vec3 d2, double size, vec3 v[4], bool swap[2]);
 
 #endif

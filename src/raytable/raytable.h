@@ -14,9 +14,8 @@ typedef struct raytable_stats {
     double seconds;
 } raytable_stats;
 
-/* POV-Ray 3.7.0.10 needs about 210 bytes of memory per mesh_camera face of a mesh with
-   "hierarchy off", its output image included (measured: 744k faces, peak RSS 164 MB against
-   15 MB for an empty scene); the default budget is 1 GB a process. */
+/* POV-Ray 3.7.0.10's memory per mesh_camera face of a mesh with "hierarchy off", its output
+   image included (docs/povray.md); the default budget is 1 GB a process. */
 #define RAYTABLE_POVRAY_BYTES_PER_FACE 215.0
 #define RAYTABLE_DEFAULT_MEMORY_MB 1024.0
 
