@@ -190,7 +190,7 @@ Test(emit, focus_puts_the_film_centre_conjugate_at_the_focus_distance)
             const double z = r.o.z - r.o.y * r.d.z / r.d.y;
             /* Far focus is ill-conditioned: a film shift delta moves the conjugate by
                delta D^2 / f^2. Allow 1e-6 relative, or a picometre on the film side. */
-            const double D = distances_m[j] * 1000.0, f = c.whole.rear_focal_length_mm;
+            const double D = distances_m[j] * 1000.0, f = c.thick.rear_focal_length_mm;
             cr_assert_float_eq(z, D, 1e-6 * D + 1e-9 * D * D / (f * f),
                                "%s at %g m: conjugate at %.9g mm", LENSES[i], distances_m[j], z);
             camera_free(&c);

@@ -49,9 +49,9 @@ Test(thicklens, cardinal_points_match_the_closed_form)
     /* Probing at 1e-5 of the aperture leaves aberrations ~1e-10 relative. */
     cr_assert_float_eq(t.rear_focal_length_mm, a.f, 1e-8 * a.f);
     cr_assert_float_eq(t.front_focal_length_mm, a.f, 1e-8 * a.f);
-    cr_assert_float_eq(t.p1_mm, a.p1, 1e-8 * a.f);
-    cr_assert_float_eq(t.p2_mm, a.p2, 1e-8 * a.f);
-    cr_assert_float_eq(t.f2_mm, a.p2 - a.f, 1e-8 * a.f);
+    cr_assert_float_eq(t.p1_z_mm, a.p1, 1e-8 * a.f);
+    cr_assert_float_eq(t.p2_z_mm, a.p2, 1e-8 * a.f);
+    cr_assert_float_eq(t.f2_z_mm, a.p2 - a.f, 1e-8 * a.f);
     lens_free(&l);
 }
 
@@ -64,7 +64,7 @@ Test(thicklens, conjugates_round_trip)
     cr_assert_float_eq(back.x, 3, 1e-12);
     cr_assert_float_eq(back.y, -2, 1e-12);
     cr_assert_float_eq(back.z, 1000, 1e-9);
-    cr_assert(!thick_real_from_image(&t, v3(1, 1, t.f2_mm), &back), "F2 images to infinity");
+    cr_assert(!thick_real_from_image(&t, v3(1, 1, t.f2_z_mm), &back), "F2 images to infinity");
 }
 
 Test(thicklens, afocal_subsystem_is_refused)

@@ -233,13 +233,13 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
        length, and the points that the camera keeps are found again at the chosen opening and
        film distance. */
     if (!st)
-        st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->whole, err);
+        st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->thick, err);
     if (!st)
-        st = setup_aperture(&c->lens, o, thick_efl_mm(&c->whole), err);
+        st = setup_aperture(&c->lens, o, thick_efl_mm(&c->thick), err);
     if (!st)
         st = setup_focus(c, o, err);
     if (!st)
-        st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->whole, err);
+        st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->thick, err);
     if (!st)
         st = pupil_make(&c->lens, o->pupil, &c->pupil, err);
     /* The stop pupil stays the seed's diagnostic, and thick tracing samples the stop's image,
@@ -249,7 +249,7 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
     if (!st) {
         double z, r;
         st = pupil_stop_image(&c->lens, false, &z, &r, err);
-        c->f_number = thick_efl_mm(&c->whole) / (2.0 * r);
+        c->f_number = thick_efl_mm(&c->thick) / (2.0 * r);
     }
     if (!st)
         st = setup_weights(c, o->weighting, err);
@@ -266,7 +266,7 @@ void camera_free(camera *c)
    the front vertex, so both kinds of trace see the same scene in front of the lens. */
 static bool trace_thick(const camera *c, ray *r)
 {
-    if (!thick_trace_toward_scene(&c->whole, r))
+    if (!thick_trace_toward_scene(&c->thick, r))
         return false;
     const double t = (c->lens.surface[0].vertex_z_mm - r->o.z) / r->d.z;
     r->o = v3_madd(r->o, r->d, t);

@@ -39,7 +39,7 @@ typedef struct camera {
     lens lens;                 /* at the chosen film distance and stop opening */
     film film;
     pupil pupil;
-    thick_lens whole;          /* thick lens of the whole lens (for --trace thick and info) */
+    thick_lens thick;          /* thick lens of the whole lens (for --trace thick and info) */
     trace_kind trace;
     weighting weighting;
     double weight_scale;       /* multiplies A cos^4 / Z^2 (1 when physical) */

@@ -21,13 +21,13 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
     if (!st) {
         memset(out, 0, sizeof *out);
         out->efl_mm = thick_efl_mm(&t);
-        out->bfd_mm = -t.f2_mm;   /* rear vertex (z = 0 here) to F2, toward the film */
-        out->ffd_mm = t.f1_mm - l.surface[0].vertex_z_mm;
+        out->bfd_mm = -t.f2_z_mm;   /* rear vertex (z = 0 here) to F2, toward the film */
+        out->ffd_mm = t.f1_z_mm - l.surface[0].vertex_z_mm;
         out->f_number = out->efl_mm / (2.0 * ep_r);
         out->stop_diameter_mm = l.stop_diameter_mm;
         out->total_length_mm = lens_total_length_mm(&l);
-        out->p1_from_rear_mm = t.p1_mm;
-        out->p2_from_rear_mm = t.p2_mm;
+        out->p1_from_rear_mm = t.p1_z_mm;
+        out->p2_from_rear_mm = t.p2_z_mm;
         out->entrance_pupil_from_rear_mm = ep_z;
         out->entrance_pupil_diameter_mm = 2.0 * ep_r;
         out->exit_pupil_from_rear_mm = exit.z_mm;

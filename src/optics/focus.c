@@ -50,16 +50,16 @@ static int thick_estimate(lens *l, double object_mm, double unit_mm, double *d, 
                         t.rear_focal_length_mm);
     double e = 0.0;
     if (!isinf(object_mm)) {
-        const double S = object_mm - t.f1_mm + t.f2_mm;
+        const double S = object_mm - t.f1_z_mm + t.f2_z_mm;
         const double disc = S * S - 4.0 * ff;
         if (!(S > 0.0) || !(disc >= 0.0))
             return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                             "focus distance %g is closer than this lens can focus: the closest "
                             "is %.6g (film plane to subject, scene units)", object_mm / unit_mm,
-                            (2.0 * sqrt(ff) + t.f1_mm - t.f2_mm) / unit_mm);
+                            (2.0 * sqrt(ff) + t.f1_z_mm - t.f2_z_mm) / unit_mm);
         e = 2.0 * ff / (S + sqrt(disc));
     }
-    *d = e - t.f2_mm;
+    *d = e - t.f2_z_mm;
     return L2P_OK;
 }
 

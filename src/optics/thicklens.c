@@ -62,34 +62,34 @@ int thick_lens_of(const lens *l, int first, int last, thick_lens *out, l2p_error
         return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[first].line,
                         "no thick lens: surfaces on lines %d to %d form an afocal system",
                         l->surface[first].line, l->surface[last].line);
-    out->f2_mm = z_at_height(&from_scene, 0.0);
-    out->p2_mm = z_at_height(&from_scene, h);
-    out->f1_mm = z_at_height(&from_film, 0.0);
-    out->p1_mm = z_at_height(&from_film, h);
-    out->front_focal_length_mm = out->f1_mm - out->p1_mm;
-    out->rear_focal_length_mm = out->p2_mm - out->f2_mm;
+    out->f2_z_mm = z_at_height(&from_scene, 0.0);
+    out->p2_z_mm = z_at_height(&from_scene, h);
+    out->f1_z_mm = z_at_height(&from_film, 0.0);
+    out->p1_z_mm = z_at_height(&from_film, h);
+    out->front_focal_length_mm = out->f1_z_mm - out->p1_z_mm;
+    out->rear_focal_length_mm = out->p2_z_mm - out->f2_z_mm;
     return L2P_OK;
 }
 
 bool thick_real_from_image(const thick_lens *t, vec3 image, vec3 *real)
 {
-    const double xi = t->f2_mm - image.z;             /* x' */
+    const double xi = t->f2_z_mm - image.z;             /* x' */
     if (xi == 0.0)
         return false;
     const double scale = -t->rear_focal_length_mm / xi; /* real / image heights */
     *real = v3(image.x * scale, image.y * scale,
-               t->f1_mm + t->front_focal_length_mm * t->rear_focal_length_mm / xi);
+               t->f1_z_mm + t->front_focal_length_mm * t->rear_focal_length_mm / xi);
     return v3_isfinite(*real);
 }
 
 bool thick_image_from_real(const thick_lens *t, vec3 real, vec3 *image)
 {
-    const double x = real.z - t->f1_mm;
+    const double x = real.z - t->f1_z_mm;
     if (x == 0.0)
         return false;
     const double scale = -t->front_focal_length_mm / x;
     *image = v3(real.x * scale, real.y * scale,
-                t->f2_mm - t->front_focal_length_mm * t->rear_focal_length_mm / x);
+                t->f2_z_mm - t->front_focal_length_mm * t->rear_focal_length_mm / x);
     return v3_isfinite(*image);
 }
 
@@ -97,12 +97,12 @@ bool thick_trace_toward_scene(const thick_lens *t, ray *r)
 {
     if (!(r->d.z > 0.0))
         return false;
-    const double to_p2 = (t->p2_mm - r->o.z) / r->d.z;
+    const double to_p2 = (t->p2_z_mm - r->o.z) / r->d.z;
     const double hx = r->o.x + r->d.x * to_p2, hy = r->o.y + r->d.y * to_p2;
     const double ratio = t->rear_focal_length_mm / t->front_focal_length_mm;
     const double sx = ratio * r->d.x / r->d.z - hx / t->front_focal_length_mm;
     const double sy = ratio * r->d.y / r->d.z - hy / t->front_focal_length_mm;
-    r->o = v3(hx, hy, t->p1_mm);
+    r->o = v3(hx, hy, t->p1_z_mm);
     r->d = v3_normalize(v3(sx, sy, 1.0));
     return v3_isfinite(r->o) && v3_isfinite(r->d);
 }

@@ -16,8 +16,8 @@
 #include "optics/trace.h"
 
 typedef struct thick_lens {
-    double p1_mm, p2_mm;   /* principal planes: P1 on the scene side, P2 on the film side */
-    double f1_mm, f2_mm;   /* focal points: F1 front (scene side), F2 rear (film side) */
+    double p1_z_mm, p2_z_mm;   /* principal planes (z): P1 on the scene side, P2 on the film side */
+    double f1_z_mm, f2_z_mm;   /* focal points (z): F1 front (scene side), F2 rear (film side) */
     double front_focal_length_mm, rear_focal_length_mm;  /* F1 - P1, P2 - F2 */
 } thick_lens;
 

@@ -75,7 +75,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (st == L2P_OK) {
         if (!isfinite(c.lens.film_distance_mm) || !isfinite(c.pupil.z_mm) ||
             !isfinite(c.pupil.radius_mm) || !isfinite(c.weight_scale) ||
-            !isfinite(c.whole.rear_focal_length_mm))
+            !isfinite(c.thick.rear_focal_length_mm))
             fail("camera_setup succeeded with a non-finite camera", "");
         trace_a_few(&c);
     } else if (st != L2P_BAD_INPUT) {
