@@ -24,8 +24,8 @@ OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenIm
 # or write (`info` and `trace` never load it). The library calls back into the executable for
 # these four functions, so every executable that may load it exports them.
 IMAGE_IO_SO    = $(BUILD)/lens2pov-image-io.so
-IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbol=outfile_track \
-                 -Wl,--export-dynamic-symbol=outfile_untrack \
+IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbol=cleanup_track \
+                 -Wl,--export-dynamic-symbol=cleanup_untrack \
                  -Wl,--export-dynamic-symbol=outfile_create_temp
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \

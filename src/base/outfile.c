@@ -11,104 +11,7 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
-
-/* Temporary paths to remove if a signal ends the run. A fixed table, so that the signal handler
-   only reads memory that is never freed while it is registered. */
-enum { MAX_TRACKED = 4096 };
-static char *volatile tracked[MAX_TRACKED];
-
-void outfile_track(const char *temp_path)
-{
-    for (int i = 0; i < MAX_TRACKED; i++)
-        if (!tracked[i]) {
-            tracked[i] = strdup(temp_path);
-            return;
-        }
-}
-
-void outfile_untrack(const char *temp_path)
-{
-    for (int i = 0; i < MAX_TRACKED; i++)
-        if (tracked[i] && strcmp(tracked[i], temp_path) == 0) {
-            char *p = tracked[i];
-            tracked[i] = NULL;
-            free(p);
-            return;
-        }
-}
-
-/* Child processes to stop with us (POV-Ray), and their count. */
-enum { MAX_CHILDREN = 256 };
-static volatile pid_t children[MAX_CHILDREN];
-
-void outfile_track_child(pid_t pid)
-{
-    for (int i = 0; i < MAX_CHILDREN; i++)
-        if (!children[i]) {
-            children[i] = pid;
-            return;
-        }
-}
-
-void outfile_untrack_child(pid_t pid)
-{
-    for (int i = 0; i < MAX_CHILDREN; i++)
-        if (children[i] == pid)
-            children[i] = 0;
-}
-
-/* A folder, with whatever is in it, goes through rm -rf in a child process: fork, execve and
-   waitpid are async-signal-safe, readdir is not. */
-static void remove_path(const char *path)
-{
-    if (unlink(path) == 0 || rmdir(path) == 0)
-        return;
-    pid_t pid = fork();
-    if (pid == 0) {
-        char *const argv[] = {"rm", "-rf", "--", (char *)path, NULL};
-        char *const envp[] = {NULL};
-        execve("/bin/rm", argv, envp);
-        _exit(127);
-    }
-    if (pid > 0)
-        waitpid(pid, NULL, 0);
-}
-
-/* Only async-signal-safe calls here. */
-static void remove_tracked_and_die(int sig)
-{
-    for (int i = 0; i < MAX_CHILDREN; i++)
-        if (children[i] > 0) {
-            kill(children[i], SIGTERM);
-            waitpid(children[i], NULL, 0);
-        }
-    for (int i = MAX_TRACKED - 1; i >= 0; i--)
-        if (tracked[i])
-            remove_path(tracked[i]);
-    signal(sig, SIG_DFL);
-    raise(sig);
-}
-
-void outfile_block_signals(sigset_t *old)
-{
-    sigset_t block;
-    sigemptyset(&block);
-    sigaddset(&block, SIGINT);
-    sigaddset(&block, SIGTERM);
-    sigaddset(&block, SIGHUP);
-    pthread_sigmask(SIG_BLOCK, &block, old);
-}
-
-void outfile_install_signal_cleanup(void)
-{
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = remove_tracked_and_die;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-    sigaction(SIGHUP, &sa, NULL);
-}
+#include "base/cleanup.h"
 
 /* 48 random bits: getrandom's, or where it fails (an old kernel) the clock's and the process's
    mixed, which no one else can predict to the nanosecond either. */
@@ -184,7 +87,7 @@ int outfile_open(outfile *f, const char *path, l2p_error *err)
     const int fd = outfile_create_temp(prefix, "", &f->temp_path);
     free(prefix);
     if (fd >= 0)
-        outfile_track(f->temp_path);
+        cleanup_track(f->temp_path);
     f->fp = fd >= 0 ? fdopen(fd, "wb") : NULL;   /* close-on-exec: not inherited by POV-Ray */
     if (!f->fp) {
         const int e = errno;
@@ -217,7 +120,7 @@ int outfile_commit(outfile *f, l2p_error *err)
     if (rename(f->temp_path, f->final_path) != 0)
         return l2p_fail(err, L2P_FAILED, f->final_path, 0, "cannot rename into place: %s",
                         strerror(errno));
-    outfile_untrack(f->temp_path);
+    cleanup_untrack(f->temp_path);
     free(f->temp_path);
     free(f->final_path);
     memset(f, 0, sizeof *f);
@@ -230,7 +133,7 @@ void outfile_discard(outfile *f)
         fclose(f->fp);
     if (f->temp_path) {
         unlink(f->temp_path);
-        outfile_untrack(f->temp_path);
+        cleanup_untrack(f->temp_path);
     }
     free(f->temp_path);
     free(f->final_path);

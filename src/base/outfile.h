@@ -1,10 +1,9 @@
 /* Outputs that are never half-written: each is written to a temporary name beside its final
    path and renamed into place only when the whole run succeeded. Temporary files are removed
-   on failure and on SIGINT, SIGTERM and SIGHUP. */
+   on failure, and on a signal (base/cleanup.h). */
 #ifndef LENS2POV_OUTFILE_H
 #define LENS2POV_OUTFILE_H
 
-#include <signal.h>
 #include <stdio.h>
 #include <sys/types.h>
 #include "base/error.h"
@@ -29,9 +28,6 @@ int outfile_create_temp(const char *prefix, const char *suffix, char **path);
    written, and path is not a folder. L2P_BAD_INPUT with a message naming path otherwise. */
 int outfile_check_path(const char *path, l2p_error *err);
 
-/* Installs the signal handlers that remove registered temporary files. Call once from main. */
-void outfile_install_signal_cleanup(void);
-
 /* Opens a temporary file beside path for writing (outfile_create_temp, "PATH.tmp..."). */
 int outfile_open(outfile *f, const char *path, l2p_error *err);
 
@@ -43,20 +39,6 @@ int outfile_commit(outfile *f, l2p_error *err);
 
 /* Closes if needed and removes the temporary file; safe to call on a committed or unopened file. */
 void outfile_discard(outfile *f);
-
-/* Registers and unregisters any temporary path (a file, or a folder with everything in it)
-   for removal on a signal. */
-void outfile_track(const char *temp_path);
-void outfile_untrack(const char *temp_path);
-
-/* Blocks, in the calling thread, the signals whose handler removes the tracked paths
-   (SIGINT, SIGTERM, SIGHUP), and gives the mask before in *old: for a fork that must track its
-   child first, and for threads that must leave the handler to the main thread. */
-void outfile_block_signals(sigset_t *old);
-
-/* Child processes to terminate (SIGTERM, then wait) before the handler removes the files. */
-void outfile_track_child(pid_t pid);
-void outfile_untrack_child(pid_t pid);
 
 #ifdef __cplusplus
 }

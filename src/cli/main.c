@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "camera/camera.h"
+#include "base/cleanup.h"
 #include "cli/cli.h"
 #include "image/develop.h"
 #include "cli/framing.h"
@@ -249,7 +250,7 @@ int main(int argc, char **argv)
     }
     if (print_command_help(argc, argv))
         return L2P_OK;
-    outfile_install_signal_cleanup();
+    cleanup_install();
     l2p_error err = {0, ""};
     cli c;
     int st = cli_parse(&c, argc, argv, 2, &err);

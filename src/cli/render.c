@@ -10,6 +10,7 @@
 #include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "base/cleanup.h"
 #include "base/cores.h"
 #include "camera/camera.h"
 #include "cli/framing.h"
@@ -106,7 +107,7 @@ static int make_workspace(workspace *w, const cli *c, l2p_error *err)
     if (!mkdtemp(w->dir))
         return l2p_fail(err, L2P_FAILED, w->dir, 0, "cannot make a temporary folder: %s",
                         strerror(errno));
-    outfile_track(w->dir);
+    cleanup_track(w->dir);
     return L2P_OK;
 }
 
@@ -126,7 +127,7 @@ static void remove_workspace(const workspace *w)
         closedir(d);
     }
     rmdir(w->dir);
-    outfile_untrack(w->dir);
+    cleanup_untrack(w->dir);
 }
 
 /* The ray table is written on a thread of its own, and POV-Ray starts on each chunk as soon as
@@ -270,7 +271,7 @@ static int publish_csv(const char *from, outfile *out, l2p_error *err)
 static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
 {
     sigset_t old;
-    outfile_block_signals(&old);
+    cleanup_block_signals(&old);
     const int r = pthread_create(t, NULL, fn, arg);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     return r;

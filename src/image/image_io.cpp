@@ -9,6 +9,7 @@
 // which OpenColorIO configuration is installed, and the tests pin exact 8-bit codes.
 
 #include "base/error.h"
+#include "base/cleanup.h"
 #include "base/outfile.h"
 #include "image/image_io_impl.h"
 
@@ -343,12 +344,12 @@ int write_rgb(const char *path, int width, int height, const float *pixels,
     std::string temp;
     if ((st = make_temp(path, ext, temp, err)))
         return st;
-    outfile_track(temp.c_str());
+    cleanup_track(temp.c_str());
     try {
         st = write_temp(temp, path, kind, spec, pixels, err);
     } catch (...) {
         unlink(temp.c_str());
-        outfile_untrack(temp.c_str());
+        cleanup_untrack(temp.c_str());
         throw;
     }
     if (!st && std::rename(temp.c_str(), path) != 0)
@@ -356,7 +357,7 @@ int write_rgb(const char *path, int width, int height, const float *pixels,
                                              std::strerror(errno));
     if (st)
         unlink(temp.c_str());
-    outfile_untrack(temp.c_str());
+    cleanup_untrack(temp.c_str());
     return st;
 }
 

@@ -32,7 +32,7 @@ typedef struct image_attribute {
    also as OIIO's float "FNumber" and "Exif:FNumber"; all of them (but "Software") also go into
    ImageDescription as "name=value" lines, unless the caller gives one, because TIFF drops
    attributes it does not know. The temporary file is "<dir>/.<base>.tmp<pid><ext>", registered
-   with outfile_track while it exists. A missing folder is L2P_BAD_INPUT (as in outfile_open),
+   with cleanup_track while it exists. A missing folder is L2P_BAD_INPUT (as in outfile_open),
    any other failure L2P_FAILED; no file is left behind on failure. */
 int image_write_rgb(const char *path, int width, int height, const float *pixels,
                     const image_attribute *attributes, int attribute_count, l2p_error *err);

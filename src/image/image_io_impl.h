@@ -22,7 +22,7 @@ typedef int image_io_write_rgb_fn(const char *path, int width, int height, const
 typedef int image_io_get_attribute_fn(const char *path, const char *name, char *buf, size_t len);
 
 /* Same contracts as image_read_rgba, image_write_rgb and image_get_attribute. The library calls
-   back into the executable for l2p_fail, outfile_track and outfile_untrack (the signal handler's
+   back into the executable for l2p_fail, cleanup_track and cleanup_untrack (the signal handler's
    list of temporary files lives there), which the executable exports for it (see Makefile). */
 image_io_read_rgba_fn image_io_impl_read_rgba;
 image_io_write_rgb_fn image_io_impl_write_rgb;

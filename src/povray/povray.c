@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
+#include "base/cleanup.h"
 #include "base/outfile.h"
 #include "base/progress.h"
 #include "povray/povray_log.h"
@@ -386,12 +387,12 @@ static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *ol
 static pid_t spawn(const run *r, char **argv, int log_fd)
 {
     sigset_t old;
-    outfile_block_signals(&old);
+    cleanup_block_signals(&old);
     const pid_t parent = getpid(), pid = fork();
     if (pid == 0)
         exec_child(r, argv, log_fd, &old, parent);
     if (pid > 0)
-        outfile_track_child(pid);
+        cleanup_track_child(pid);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     return pid;
 }
@@ -446,7 +447,7 @@ static void stop_jobs(run *r)
                 kill(j->pid, SIGKILL);
             const pid_t w = waitpid(j->pid, NULL, tick >= STOP_WAIT_TICKS ? 0 : WNOHANG);
             if (w == j->pid || (w < 0 && errno == ECHILD)) {
-                outfile_untrack_child(j->pid);
+                cleanup_untrack_child(j->pid);
                 j->pid = 0;
             } else {
                 running++;
@@ -520,7 +521,7 @@ static int reap_jobs(run *r, int *st, l2p_error *err)
         int status;
         if (!j->pid || waitpid(j->pid, &status, WNOHANG) != j->pid)
             continue;
-        outfile_untrack_child(j->pid);
+        cleanup_untrack_child(j->pid);
         j->pid = 0;
         ended++;
         if (!*st)

@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "base/cleanup.h"
 #include "base/outfile.h"
 #include "povray/povray_log.h"
 
@@ -370,7 +371,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     if (fd < 0)
         return l2p_fail(err, L2P_FAILED, log, 0, "cannot write: %s", strerror(errno));
     sigset_t old;
-    outfile_block_signals(&old);
+    cleanup_block_signals(&old);
     const pid_t pid = fork();
     if (pid == 0) {
         prctl(PR_SET_PDEATHSIG, SIGTERM);   /* gone with lens2pov, however it ends */
@@ -388,7 +389,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
         _exit(127);
     }
     if (pid > 0)
-        outfile_track_child(pid);
+        cleanup_track_child(pid);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     close(fd);
     if (pid < 0)
@@ -396,7 +397,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     int status;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
         ;
-    outfile_untrack_child(pid);
+    cleanup_untrack_child(pid);
     if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "%s: cannot run it (install Debian's povray "
                         "package) or cannot enter %s", exe, dir);
@@ -474,12 +475,12 @@ int scene_camera_read(const char *scene, int width, int height, scene_camera *ou
     if (!mkdtemp(work))
         return l2p_fail(err, L2P_FAILED, work, 0, "cannot make a temporary folder: %s",
                         strerror(errno));
-    outfile_track(work);
+    cleanup_track(work);
     char *dir = folder_of(scene);
     const int st = dir ? probe(scene, dir, work, width, height, out, err)
                        : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     free(dir);
     rmdir(work);
-    outfile_untrack(work);
+    cleanup_untrack(work);
     return st;
 }
