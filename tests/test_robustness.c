@@ -671,6 +671,10 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
     cr_assert_eq(mkdir(sub, 0755), 0);
     cr_assert_eq(mkdir(tmp_path(dir, "dir.png"), 0755), 0);
     char *dir_png = strdup(tmp_path(dir, "dir.png"));
+    /* Names POV-Ray's .ini (or its command line, for the workspace) cannot carry. */
+    char *quote = strdup(tmp_path(dir, "a\"b")), *newline = strdup(tmp_path(dir, "a\nb"));
+    char *accent = strdup(tmp_path(dir, "caf\xc3\xa9")), *keep_quote = strdup(tmp_path(dir, "k\"eep"));
+    char *keep_missing = strdup(tmp_path(dir, "missing/keep"));
     struct {
         const char *args[16];
         const char *named;
@@ -682,6 +686,12 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
         {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", dir_png}, dir_png},
         {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--rays", sub}, sub},
         {{"develop", out, "-o", missing_png}, missing_png},
+        {{"trace", DGAUSS, "-o", quote}, quote},
+        {{"trace", DGAUSS, "-o", newline}, newline},
+        {{"trace", DGAUSS, "-o", accent}, accent},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", keep_quote}, keep_quote},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", keep_missing}, keep_missing},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", scene}, scene},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         const char *const *a = cases[i].args;
@@ -689,7 +699,7 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
         struct timespec t0, t1;
         clock_gettime(CLOCK_MONOTONIC, &t0);
         const int st = run_lens2pov(NULL, &errtext, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
-                                    a[8], a[9], a[10], a[11], a[12], a[13], NULL);
+                                    a[8], a[9], a[10], a[11], a[12], a[13], a[14], a[15], NULL);
         clock_gettime(CLOCK_MONOTONIC, &t1);
         const double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
         cr_expect_eq(st, 2, "case %zu: exit %d: %s", i, st, errtext);
@@ -707,6 +717,30 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
     free(out);
     free(png);
     free(dir_png);
+    free(quote);
+    free(newline);
+    free(accent);
+    free(keep_quote);
+    free(keep_missing);
+}
+
+/* ';', '#', '\'' and ',' end or split an unquoted .ini value: the ini quotes a name that has
+   them, and POV-Ray writes the render where it says. */
+Test(robustness, ini_names_renders_with_semicolons_and_commas_quoted)
+{
+    const char *dir = test_tmpdir();
+    char *prefix = strdup(tmp_path(dir, "x;y,z#w'v"));
+    cr_assert_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "8", "--height", "6",
+                              "-q", "-o", prefix, NULL), 0);
+    char ini[600], want[700];
+    snprintf(ini, sizeof ini, "%s.ini", prefix);
+    snprintf(want, sizeof want, "Output_File_Name=\"%s.exr\"\n", prefix);
+    char *text = read_text(ini, NULL);
+    cr_assert_not_null(text);
+    cr_expect_not_null(strstr(text, want), "%s", text);
+    free(text);
+    free(prefix);
+    remove_tree(dir);
 }
 
 /* Every command answers --help with exit 0 on stdout, naming each option it takes and its

@@ -29,6 +29,10 @@ int outfile_create_temp(const char *prefix, const char *suffix, char **path);
    written, and path is not a folder. L2P_BAD_INPUT with a message naming path otherwise. */
 int outfile_check_path(const char *path, l2p_error *err);
 
+/* The same for a folder that is kept or made: an existing one must be a folder that may be
+   written, a new one's parent must exist and may be written. */
+int outfile_check_dir(const char *path, l2p_error *err);
+
 /* Installs the signal handlers that remove registered temporary files. Call once from main. */
 void outfile_install_signal_cleanup(void);
 

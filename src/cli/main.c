@@ -119,6 +119,8 @@ static int check_trace_outputs(const cli *c, l2p_error *err)
     sprintf(inc, "%s.inc", c->output);
     int st = outfile_check_path(inc, err);
     free(inc);
+    if (!st)
+        st = povmesh_check_prefix(c->output, err);
     if (!st && c->rays_csv)
         st = outfile_check_path(c->rays_csv, err);
     return st;

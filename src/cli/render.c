@@ -17,6 +17,27 @@
 #include "povray/povray.h"
 #include "raytable/raytable.h"
 
+static const char *temp_root(void)
+{
+    const char *tmp = getenv("TMPDIR");
+    return tmp && *tmp ? tmp : "/tmp";
+}
+
+/* POV-Ray is given the workspace's files by name (the chunks' .ini and renders), so the
+   workspace (--keep-temp, else under $TMPDIR) must have a name it reads as it is. */
+static int check_workspace_path(const cli *c, l2p_error *err)
+{
+    const char *dir = c->keep_temp ? c->keep_temp : temp_root();
+    char cwd[4096] = "";
+    if (dir[0] != '/' && !getcwd(cwd, sizeof cwd))
+        cwd[0] = '\0';
+    if (povray_path_is_plain(cwd) && povray_path_is_plain(dir))
+        return L2P_OK;
+    return l2p_fail(err, L2P_BAD_INPUT, dir, 0, "POV-Ray 3.7 cannot use this folder for its "
+                    "files (only plain ASCII without '\"' or '\\'): %s",
+                    c->keep_temp ? "give another --keep-temp" : "set TMPDIR to another");
+}
+
 static int check_inputs(const cli *c, l2p_error *err)
 {
     if (c->positional_count != 2)
@@ -35,7 +56,9 @@ static int check_inputs(const cli *c, l2p_error *err)
     int st = outfile_check_path(c->output, err);
     if (!st && c->rays_csv)
         st = outfile_check_path(c->rays_csv, err);
-    return st;
+    if (!st && c->keep_temp)
+        st = outfile_check_dir(c->keep_temp, err);
+    return st ? st : check_workspace_path(c, err);
 }
 
 static int number_of_cores(void)
@@ -102,8 +125,7 @@ static int make_workspace(workspace *w, const cli *c, l2p_error *err)
             return l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "cannot make folder: %s", strerror(errno));
         return L2P_OK;
     }
-    const char *tmp = getenv("TMPDIR");
-    tmp = tmp && *tmp ? tmp : "/tmp";
+    const char *tmp = temp_root();
     remove_stale_workspaces(tmp);
     snprintf(w->dir, sizeof w->dir, "%s/lens2pov.%ld.XXXXXX", tmp, (long)getpid());
     if (!mkdtemp(w->dir))
