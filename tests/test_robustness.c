@@ -844,3 +844,106 @@ Test(robustness, info_prints_the_camera_only_for_camera_options)
     cr_expect_not_null(strstr(out, "film_distance_mm"), "%s", out);
     free(out);
 }
+
+/* ---------------------------------------------------------------- size estimates */
+
+static double seconds_since(const struct timespec *t0)
+{
+    struct timespec t1;
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    return (double)(t1.tv_sec - t0->tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0->tv_nsec);
+}
+
+/* A request no disk holds (4e11 rays: tens of terabytes) is refused from its estimate in well
+   under a second, naming it, with nothing written; the same options on a small film work. */
+Test(robustness, requests_that_cannot_fit_are_refused_before_tracing)
+{
+    const char *dir = test_tmpdir();
+    char *scene = strdup(tmp_path(dir, "scene.pov")), *out = strdup(tmp_path(dir, "out"));
+    char *png = strdup(tmp_path(dir, "out.png")), *keep = strdup(tmp_path(dir, "keep"));
+    char *csv = strdup(tmp_path(dir, "out.csv"));
+    write_text(scene, "background { rgb 1 }\n");
+    const char *huge[] = {"--width", "20000", "--height", "20000", "--spp", "1000"};
+    struct {
+        const char *args[16];
+    } cases[] = {
+        {{"trace", DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o", out}},
+        {{"trace", DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o", out,
+          "--rays", csv}},
+        {{"render", scene, DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o",
+          png}},
+        {{"render", scene, DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o",
+          png, "--keep-temp", keep}},
+        {{"render", scene, DGAUSS, "--width", "320", "--height", "240", "--spp", "100000", "-o",
+          png}},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *const *a = cases[i].args;
+        char *errtext = NULL;
+        struct timespec t0;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        const int st = run_lens2pov(NULL, &errtext, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
+                                    a[8], a[9], a[10], a[11], a[12], a[13], a[14], NULL);
+        const double seconds = seconds_since(&t0);
+        cr_expect_eq(st, 2, "case %zu: exit %d: %s", i, st, errtext);
+        cr_expect(errtext && strstr(errtext, "--no-size-check") && strstr(errtext, "B of "),
+                  "case %zu: %s", i, errtext);
+        cr_expect_lt(seconds, 1.0, "case %zu took %.2f s", i, seconds);
+        free(errtext);
+        const char *const allowed[] = {"scene.pov", NULL};
+        const char *first;
+        cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "case %zu wrote %s", i, first);
+    }
+    cr_expect_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "20", "--height", "15",
+                              "--spp", "2", "-o", out, "-q", NULL), 0);
+    cr_expect_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "20", "--height", "15",
+                              "--spp", "2", "-o", out, "-q", "--no-size-check", NULL), 0);
+    free(scene);
+    free(out);
+    free(png);
+    free(keep);
+    free(csv);
+    remove_tree(dir);
+}
+
+/* ---------------------------------------------------------------- all or nothing */
+
+/* trace replaces its set (include, ini, map, CSV) whole or not at all: a --rays that is a
+   folder, or a map or ini whose name is a folder, is refused before any work, and the
+   previous run's four files are left as they were. */
+Test(robustness, trace_replaces_its_set_whole_or_not_at_all)
+{
+    const char *dir = test_tmpdir();
+    char *prefix = strdup(tmp_path(dir, "p")), *csv = strdup(tmp_path(dir, "p.csv"));
+    char *folder = strdup(tmp_path(dir, "sub"));
+    previous_run before = make_previous_run(dir);
+    cr_assert_eq(mkdir(folder, 0755), 0);
+    char *errtext = NULL;
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "16", "--height", "12",
+                              "--rays", folder, "-o", prefix, "-q", NULL), 2, "%s", errtext);
+    cr_expect(errtext && strstr(errtext, folder), "%s", errtext);
+    free(errtext);
+    expect_previous_run(dir, &before, "--rays naming a folder");
+
+    /* p.map a folder: the other three stay the previous run's. */
+    before = make_previous_run(dir);
+    char *map = strdup(tmp_path(dir, "p.map")), *saved = strdup(tmp_path(dir, "p.map.saved"));
+    cr_assert_eq(rename(map, saved), 0);
+    cr_assert_eq(mkdir(map, 0755), 0);
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "16", "--height", "12",
+                              "--rays", csv, "-o", prefix, "-q", NULL), 2, "%s", errtext);
+    cr_expect(errtext && strstr(errtext, map), "%s", errtext);
+    free(errtext);
+    cr_assert_eq(rmdir(map), 0);
+    cr_assert_eq(rename(saved, map), 0);
+    expect_previous_run(dir, &before, "p.map being a folder");
+    const char *const allowed[] = {"p.inc", "p.ini", "p.map", "p.csv", "sub", NULL};
+    const char *first;
+    cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "left %s", first);
+    free(prefix);
+    free(csv);
+    free(folder);
+    free(map);
+    free(saved);
+    remove_tree(dir);
+}

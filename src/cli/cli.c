@@ -62,6 +62,9 @@ static const cli_option OPTIONS[] = {
      "  -q, --quiet                   no progress or summary on stderr\n"},
     {"--quiet", "-q", CMD_RENDER, true, false,
      "  -q, --quiet                   no progress on stderr\n"},
+    {"--no-size-check", NULL, CMD_SAMPLES, true, false,
+     "  --no-size-check               go on when the outputs seem not to fit the disk\n"
+     "                                or memory [refuse, naming the estimate]\n"},
     {"--width", NULL, CMD_CAMERA, false, true,
      "  --width N --height N          film pixels [640 x 480]\n"},
     {"--height", NULL, CMD_CAMERA, false, true, NULL},
@@ -370,6 +373,8 @@ static void set_flag(cli *c, const cli_option *o)
         c->json = true;
     else if (!strcmp(o->name, "--quiet"))
         c->quiet = true;
+    else if (!strcmp(o->name, "--no-size-check"))
+        c->no_size_check = true;
 }
 
 /* The option a word names, for this command; NULL with the error set when the command does not

@@ -21,6 +21,7 @@ typedef struct cli {
     double memory_mb;            /* --memory-mb: POV-Ray memory budget per process (chunks) */
     bool json;                   /* --json */
     bool quiet;                  /* --quiet: no progress bar */
+    bool no_size_check;          /* --no-size-check: trace even what seems not to fit */
     bool film_given;             /* a camera option was given (info prints the camera) */
 } cli;
 

@@ -9,6 +9,7 @@
 #include "base/outfile.h"
 #include "raytable/raytable.h"
 #include "cli/render.h"
+#include "cli/sizecheck.h"
 
 #define LENS2POV_VERSION "0.4"
 
@@ -110,15 +111,20 @@ static int cmd_info(const cli *c, l2p_error *err)
     return st;
 }
 
-/* trace's outputs, checked before any work: PREFIX.inc stands for the set beside it. */
+/* trace's outputs, checked before any work: PREFIX.inc, .ini and .map (a chunked table's
+   files are checked again before the first is renamed into place). */
 static int check_trace_outputs(const cli *c, l2p_error *err)
 {
-    char *inc = malloc(strlen(c->output) + 5);
-    if (!inc)
+    char *path = malloc(strlen(c->output) + 5);
+    if (!path)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    sprintf(inc, "%s.inc", c->output);
-    int st = outfile_check_path(inc, err);
-    free(inc);
+    static const char *const ext[] = {"inc", "ini", "map"};
+    int st = L2P_OK;
+    for (int i = 0; i < 3 && !st; i++) {
+        sprintf(path, "%s.%s", c->output, ext[i]);
+        st = outfile_check_path(path, err);
+    }
+    free(path);
     if (!st)
         st = povmesh_check_prefix(c->output, err);
     if (!st && c->rays_csv)
@@ -130,7 +136,7 @@ static int cmd_trace(const cli *c, l2p_error *err)
 {
     camera cam;
     int st = need(c, 1, true, err);
-    if (st || (st = check_trace_outputs(c, err)) ||
+    if (st || (st = check_trace_outputs(c, err)) || (st = size_check_trace(c, err)) ||
         (st = load_camera(c, c->positional[0], &cam, err)))
         return st;
     cli_warn(c, &cam);

@@ -15,6 +15,7 @@
 #include "image/image_io.h"
 #include "base/outfile.h"
 #include "povray/povray.h"
+#include "cli/sizecheck.h"
 #include "raytable/raytable.h"
 
 static const char *temp_root(void)
@@ -342,7 +343,10 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
 
 int render_command(const cli *c, l2p_error *err)
 {
+    const int jobs = c->jobs > 0 ? c->jobs : number_of_cores();
     int st = check_inputs(c, err);
+    if (!st)
+        st = size_check_render(c, c->keep_temp ? c->keep_temp : temp_root(), jobs, err);
     if (st)
         return st;
     lens l;
@@ -357,7 +361,6 @@ int render_command(const cli *c, l2p_error *err)
     pthread_t loader;
     if (start_thread(&loader, load_image_library, NULL) == 0)
         pthread_detach(loader);   /* image_io_ready waits for it */
-    const int jobs = c->jobs > 0 ? c->jobs : number_of_cores();
     workspace w;
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
