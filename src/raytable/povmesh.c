@@ -3,6 +3,7 @@
 #include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "raytable/facelist.h"
 #include "base/outfile.h"
@@ -471,9 +472,24 @@ static int finish_all(povmesh_emitter *e, l2p_error *err)
     return st;
 }
 
+/* A target that turned into a folder during the run cannot be renamed onto: found before
+   the first rename, so that the set is replaced whole or not at all. */
+static int check_target(const outfile *f, l2p_error *err)
+{
+    struct stat sb;
+    if (f->temp_path && stat(f->final_path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return l2p_fail(err, L2P_FAILED, f->final_path, 0, "cannot write: Is a directory");
+    return L2P_OK;
+}
+
 static int commit_all(povmesh_emitter *e, l2p_error *err)
 {
-    int st = L2P_OK;
+    int st = check_target(&e->map, err);
+    if (!st && e->has_csv)
+        st = check_target(&e->csv.file, err);
+    for (int i = 0; i < e->chunk_count && !st; i++)
+        if (!e->chunks[i].committed && !(st = check_target(&e->chunks[i].inc.file, err)))
+            st = check_target(&e->chunks[i].ini, err);
     for (int i = 0; i < e->chunk_count && !st; i++)
         if (!e->chunks[i].committed && !(st = outfile_commit(&e->chunks[i].inc.file, err)))
             st = outfile_commit(&e->chunks[i].ini, err);
