@@ -947,3 +947,36 @@ Test(robustness, trace_replaces_its_set_whole_or_not_at_all)
     free(saved);
     remove_tree(dir);
 }
+
+/* ---------------------------------------------------------------- info validates as trace */
+
+/* A lens that forms no real image (a biconcave singlet; the double-Gauss with its second
+   index typed 16.99, whose focal length comes out negative) is refused by info exactly as by trace. */
+Test(robustness, info_refuses_the_lenses_trace_refuses_with_the_same_message)
+{
+    static const char *const lenses[] = {
+        "-50 5 1.5 20\n0 5 0 10\n50 0 1 20\n",
+        "29.475 3.76 1.67 25.2\n84.83 0.12 16.99 25.2\n19.275 4.025 1.67 23\n"
+        "40.77 3.275 1.699 23\n12.75 5.705 1 18\n0 4.5 0 17.1\n-14.495 1.18 1.603 17\n"
+        "40.77 6.065 1.658 20\n-20.385 0.19 1 20\n437.065 3.22 1.717 20\n-39.73 0 1 20\n",
+    };
+    for (size_t i = 0; i < sizeof lenses / sizeof lenses[0]; i++) {
+        const char *dir = test_tmpdir();
+        char *lens = strdup(tmp_path(dir, "bad.dat")), *out = strdup(tmp_path(dir, "p"));
+        write_text(lens, lenses[i]);
+        char *info_err = NULL, *trace_err = NULL, *info_out = NULL;
+        const int si = run_lens2pov(&info_out, &info_err, "info", lens, NULL);
+        const int st = run_lens2pov(NULL, &trace_err, "trace", lens, "-o", out, "-q", NULL);
+        cr_expect_eq(si, 2, "lens %zu: info exit %d: %s", i, si, info_out);
+        cr_expect_eq(st, 2, "lens %zu: trace exit %d", i, st);
+        cr_expect_str_eq(info_err, trace_err, "lens %zu", i);
+        cr_expect_not_null(strstr(info_err, "diverges light"), "lens %zu: %s", i, info_err);
+        cr_expect_str_empty(info_out, "lens %zu", i);
+        free(info_err);
+        free(trace_err);
+        free(info_out);
+        free(lens);
+        free(out);
+        remove_tree(dir);
+    }
+}
