@@ -122,10 +122,19 @@ valgrind: deps $(BUILD)/lens2pov
 
 # The image library goes to PREFIX/lib/lens2pov/, where lens2pov looks for it (../lib/lens2pov
 # from its own folder) when it is not beside it.
+# The batch script goes beside it as lens2pov-render-all, the man page to share/man/man1, the
+# user's guide and docs to share/doc/lens2pov.
 install: $(BUILD)/lens2pov
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/lens2pov \
-	  $(DESTDIR)$(PREFIX)/share/lens2pov/lenses $(DESTDIR)$(PREFIX)/share/lens2pov/pov
+	  $(DESTDIR)$(PREFIX)/share/lens2pov/lenses $(DESTDIR)$(PREFIX)/share/lens2pov/pov \
+	  $(DESTDIR)$(PREFIX)/share/man/man1 $(DESTDIR)$(PREFIX)/share/doc/lens2pov/docs \
+	  $(DESTDIR)$(PREFIX)/share/doc/lens2pov/examples
 	install -m 755 $(BUILD)/lens2pov $(DESTDIR)$(PREFIX)/bin/lens2pov
+	install -m 755 examples/render-all-lenses.sh $(DESTDIR)$(PREFIX)/bin/lens2pov-render-all
+	install -m 644 docs/lens2pov.1 $(DESTDIR)$(PREFIX)/share/man/man1/lens2pov.1
+	install -m 644 README.md $(DESTDIR)$(PREFIX)/share/doc/lens2pov
+	install -m 644 examples/README.md $(DESTDIR)$(PREFIX)/share/doc/lens2pov/examples
+	install -m 644 docs/*.md docs/*.png $(DESTDIR)$(PREFIX)/share/doc/lens2pov/docs
 	install -m 644 $(IMAGE_IO_SO) $(DESTDIR)$(PREFIX)/lib/lens2pov/lens2pov-image-io.so
 	install -m 644 lenses/*.dat $(DESTDIR)$(PREFIX)/share/lens2pov/lenses
 	install -m 644 pov/* $(DESTDIR)$(PREFIX)/share/lens2pov/pov

@@ -34,12 +34,18 @@ shift 2
 
 here=$(CDPATH='' cd -- "$(dirname -- "$0")" && pwd) || exit 2
 repo=$(dirname -- "$here")
-lens_dir=${LENS_DIR:-$repo/lenses}
+# From a clone, the repository's lenses and build; installed (PREFIX/bin/lens2pov-render-all),
+# PREFIX/share/lens2pov/lenses and the lens2pov beside it.
+lens_dir=$repo/lenses
+[ -d "$lens_dir" ] || lens_dir=$repo/share/lens2pov/lenses
+lens_dir=${LENS_DIR:-$lens_dir}
 font=${FONT:-DejaVuSans}
 if [ -n "${LENS2POV:-}" ]; then
     bin=$LENS2POV
 elif [ -x "$repo/build/lens2pov" ]; then
     bin=$repo/build/lens2pov
+elif [ -x "$here/lens2pov" ]; then
+    bin=$here/lens2pov
 else
     bin=$(command -v lens2pov) || die "no lens2pov: run make in $repo, put it on PATH or set LENS2POV"
 fi

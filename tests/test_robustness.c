@@ -142,6 +142,14 @@ static const bad_line BAD_OPTIONS[] = {
     {{"frobnicate", DGAUSS, "-o", "OUT"}, "frobnicate"},
     {{"info", DGAUSS, "--width", "0"}, "--width"},
     {{"info", DGAUSS, "--spp", "-1"}, "--spp"},
+    /* options the command does not take */
+    {{"trace", DGAUSS, "--jobs", "2", "-o", "OUT"}, "trace does not take --jobs"},
+    {{"info", DGAUSS, "--quiet"}, "info does not take --quiet"},
+    {{"info", DGAUSS, "--seed", "3"}, "info does not take --seed"},
+    {{"info", DGAUSS, "-o", "OUT"}, "info does not take -o"},
+    {{"develop", "OUT", "--spp", "4", "-o", "OUTEXR"}, "develop does not take --spp"},
+    {{"render", "SCENE", DGAUSS, "--json", "-o", "OUTEXR"}, "render does not take --json"},
+    {{"info", DGAUSS, "--json=1"}, "--json"},
 };
 
 /* Rows first .. last-1 of the table (the table is split over several tests, which Criterion
@@ -656,6 +664,10 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
     cr_assert_eq(mkdir(sub, 0755), 0);
     cr_assert_eq(mkdir(tmp_path(dir, "dir.png"), 0755), 0);
     char *dir_png = strdup(tmp_path(dir, "dir.png"));
+    /* Names POV-Ray's .ini (or its command line, for the workspace) cannot carry. */
+    char *quote = strdup(tmp_path(dir, "a\"b")), *newline = strdup(tmp_path(dir, "a\nb"));
+    char *accent = strdup(tmp_path(dir, "caf\xc3\xa9")), *keep_quote = strdup(tmp_path(dir, "k\"eep"));
+    char *keep_missing = strdup(tmp_path(dir, "missing/keep"));
     struct {
         const char *args[16];
         const char *named;
@@ -667,6 +679,12 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
         {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", dir_png}, dir_png},
         {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--rays", sub}, sub},
         {{"develop", out, "-o", missing_png}, missing_png},
+        {{"trace", DGAUSS, "-o", quote}, quote},
+        {{"trace", DGAUSS, "-o", newline}, newline},
+        {{"trace", DGAUSS, "-o", accent}, accent},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", keep_quote}, keep_quote},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", keep_missing}, keep_missing},
+        {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", scene}, scene},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         const char *const *a = cases[i].args;
@@ -674,7 +692,7 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
         struct timespec t0, t1;
         clock_gettime(CLOCK_MONOTONIC, &t0);
         const int st = run_lens2pov(NULL, &errtext, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
-                                    a[8], a[9], a[10], a[11], a[12], a[13], NULL);
+                                    a[8], a[9], a[10], a[11], a[12], a[13], a[14], a[15], NULL);
         clock_gettime(CLOCK_MONOTONIC, &t1);
         const double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
         cr_expect_eq(st, 2, "case %zu: exit %d: %s", i, st, errtext);
@@ -692,6 +710,30 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
     free(out);
     free(png);
     free(dir_png);
+    free(quote);
+    free(newline);
+    free(accent);
+    free(keep_quote);
+    free(keep_missing);
+}
+
+/* ';', '#', '\'' and ',' end or split an unquoted .ini value: the ini quotes a name that has
+   them, and POV-Ray writes the render where it says. */
+Test(robustness, ini_names_renders_with_semicolons_and_commas_quoted)
+{
+    const char *dir = test_tmpdir();
+    char *prefix = strdup(tmp_path(dir, "x;y,z#w'v"));
+    cr_assert_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "8", "--height", "6",
+                              "-q", "-o", prefix, NULL), 0);
+    char ini[600], want[700];
+    snprintf(ini, sizeof ini, "%s.ini", prefix);
+    snprintf(want, sizeof want, "Output_File_Name=\"%s.exr\"\n", prefix);
+    char *text = read_text(ini, NULL);
+    cr_assert_not_null(text);
+    cr_expect_not_null(strstr(text, want), "%s", text);
+    free(text);
+    free(prefix);
+    remove_tree(dir);
 }
 
 /* Every command answers --help with exit 0 on stdout, naming each option it takes and its
@@ -702,7 +744,7 @@ Test(robustness, every_command_has_help_and_there_is_a_version)
         const char *command;
         const char *options[12];
     } cases[] = {
-        {"info", {"--json", "--width", "--spp", "--pupil", "--seed", "[640 x 480]", "[16]"}},
+        {"info", {"--json", "--width", "--pupil", "--unit-mm", "[640 x 480]"}},
         {"trace", {"--output", "--rays", "--memory-mb", "--quiet", "--crop", "--unit-mm", "[1000]"}},
         {"develop", {"--output"}},
         {"render", {"--output", "--jobs", "--memory-mb", "--rays", "--keep-temp", "--quiet",
@@ -724,4 +766,210 @@ Test(robustness, every_command_has_help_and_there_is_a_version)
     cr_assert_eq(strncmp(out, "lens2pov ", 9), 0, "%s", out);
     free(out);
     free(errtext);
+}
+
+/* "--name" options a help text lists (long names only), into names[], at most max. */
+static int listed_options(const char *help, char names[][32], int count, int max)
+{
+    for (const char *p = help; (p = strstr(p, "--")) != NULL; p += 2) {
+        if (p > help && p[-1] != ' ' && p[-1] != '|')
+            continue;
+        size_t n = 2;
+        while ((p[n] >= 'a' && p[n] <= 'z') || p[n] == '-')
+            n++;
+        bool seen = false;
+        for (int i = 0; i < count; i++)
+            seen |= strlen(names[i]) == n && !strncmp(names[i], p, n);
+        if (!seen && n > 2 && n < 32 && count < max)
+            snprintf(names[count++], 32, "%.*s", (int)n, p);
+    }
+    return count;
+}
+
+static bool help_lists(const char *help, const char *name)
+{
+    char names[64][32];
+    const int n = listed_options(help, names, 0, 64);
+    for (int i = 0; i < n; i++)
+        if (!strcmp(names[i], name))
+            return true;
+    return false;
+}
+
+/* The options a command accepts are exactly those its --help lists: every option any command
+   lists is tried on every command; where it is not listed, the refusal names the command and
+   the option (exit 2); where it is, it is not refused as foreign. */
+Test(robustness, each_command_takes_exactly_the_options_its_help_lists)
+{
+    static const char *const commands[] = {"info", "trace", "develop", "render"};
+    char *help[4];
+    char names[64][32];
+    int count = 0;
+    for (int k = 0; k < 4; k++) {
+        cr_assert_eq(run_lens2pov(&help[k], NULL, commands[k], "--help", NULL), 0);
+        count = listed_options(help[k], names, count, 64);
+    }
+    cr_assert_gt(count, 20, "%d options in the help texts", count);
+    for (int k = 0; k < 4; k++)
+        for (int i = 0; i < count; i++) {
+            char *errtext = NULL, expect[2100];
+            const int st = run_lens2pov(NULL, &errtext, commands[k], names[i], NULL);
+            snprintf(expect, sizeof expect, "%s does not take %s", commands[k], names[i]);
+            if (help_lists(help[k], names[i]))
+                cr_expect_null(strstr(errtext, "does not take"), "%s: %s", expect, errtext);
+            else
+                cr_expect(st == 2 && strstr(errtext, expect), "%s %s: exit %d: %s", commands[k],
+                          names[i], st, errtext);
+            free(errtext);
+        }
+    for (int k = 0; k < 4; k++)
+        free(help[k]);
+}
+
+/* info prints the camera only when a camera option asks for one: not for --json alone. */
+Test(robustness, info_prints_the_camera_only_for_camera_options)
+{
+    char *out = NULL;
+    cr_assert_eq(run_lens2pov(&out, NULL, "info", DGAUSS, "--json", NULL), 0);
+    cr_expect_null(strstr(out, "film_distance_mm"), "%s", out);
+    free(out);
+    cr_assert_eq(run_lens2pov(&out, NULL, "info", DGAUSS, "--json", "--width", "64", NULL), 0);
+    cr_expect_not_null(strstr(out, "film_distance_mm"), "%s", out);
+    free(out);
+}
+
+/* ---------------------------------------------------------------- size estimates */
+
+static double seconds_since(const struct timespec *t0)
+{
+    struct timespec t1;
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    return (double)(t1.tv_sec - t0->tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0->tv_nsec);
+}
+
+/* A request no disk holds (4e11 rays: tens of terabytes) is refused from its estimate in well
+   under a second, naming it, with nothing written; the same options on a small film work. */
+Test(robustness, requests_that_cannot_fit_are_refused_before_tracing)
+{
+    const char *dir = test_tmpdir();
+    char *scene = strdup(tmp_path(dir, "scene.pov")), *out = strdup(tmp_path(dir, "out"));
+    char *png = strdup(tmp_path(dir, "out.png")), *keep = strdup(tmp_path(dir, "keep"));
+    char *csv = strdup(tmp_path(dir, "out.csv"));
+    write_text(scene, "background { rgb 1 }\n");
+    const char *huge[] = {"--width", "20000", "--height", "20000", "--spp", "1000"};
+    struct {
+        const char *args[16];
+    } cases[] = {
+        {{"trace", DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o", out}},
+        {{"trace", DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o", out,
+          "--rays", csv}},
+        {{"render", scene, DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o",
+          png}},
+        {{"render", scene, DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o",
+          png, "--keep-temp", keep}},
+        {{"render", scene, DGAUSS, "--width", "320", "--height", "240", "--spp", "100000", "-o",
+          png}},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *const *a = cases[i].args;
+        char *errtext = NULL;
+        struct timespec t0;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        const int st = run_lens2pov(NULL, &errtext, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
+                                    a[8], a[9], a[10], a[11], a[12], a[13], a[14], NULL);
+        const double seconds = seconds_since(&t0);
+        cr_expect_eq(st, 2, "case %zu: exit %d: %s", i, st, errtext);
+        cr_expect(errtext && strstr(errtext, "--no-size-check") && strstr(errtext, "B of "),
+                  "case %zu: %s", i, errtext);
+        cr_expect_lt(seconds, 1.0, "case %zu took %.2f s", i, seconds);
+        free(errtext);
+        const char *const allowed[] = {"scene.pov", NULL};
+        const char *first;
+        cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "case %zu wrote %s", i, first);
+    }
+    cr_expect_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "20", "--height", "15",
+                              "--spp", "2", "-o", out, "-q", NULL), 0);
+    cr_expect_eq(run_lens2pov(NULL, NULL, "trace", DGAUSS, "--width", "20", "--height", "15",
+                              "--spp", "2", "-o", out, "-q", "--no-size-check", NULL), 0);
+    free(scene);
+    free(out);
+    free(png);
+    free(keep);
+    free(csv);
+    remove_tree(dir);
+}
+
+/* ---------------------------------------------------------------- all or nothing */
+
+/* trace replaces its set (include, ini, map, CSV) whole or not at all: a --rays that is a
+   folder, or a map or ini whose name is a folder, is refused before any work, and the
+   previous run's four files are left as they were. */
+Test(robustness, trace_replaces_its_set_whole_or_not_at_all)
+{
+    const char *dir = test_tmpdir();
+    char *prefix = strdup(tmp_path(dir, "p")), *csv = strdup(tmp_path(dir, "p.csv"));
+    char *folder = strdup(tmp_path(dir, "sub"));
+    previous_run before = make_previous_run(dir);
+    cr_assert_eq(mkdir(folder, 0755), 0);
+    char *errtext = NULL;
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "16", "--height", "12",
+                              "--rays", folder, "-o", prefix, "-q", NULL), 2, "%s", errtext);
+    cr_expect(errtext && strstr(errtext, folder), "%s", errtext);
+    free(errtext);
+    expect_previous_run(dir, &before, "--rays naming a folder");
+
+    /* p.map a folder: the other three stay the previous run's. */
+    before = make_previous_run(dir);
+    char *map = strdup(tmp_path(dir, "p.map")), *saved = strdup(tmp_path(dir, "p.map.saved"));
+    cr_assert_eq(rename(map, saved), 0);
+    cr_assert_eq(mkdir(map, 0755), 0);
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "16", "--height", "12",
+                              "--rays", csv, "-o", prefix, "-q", NULL), 2, "%s", errtext);
+    cr_expect(errtext && strstr(errtext, map), "%s", errtext);
+    free(errtext);
+    cr_assert_eq(rmdir(map), 0);
+    cr_assert_eq(rename(saved, map), 0);
+    expect_previous_run(dir, &before, "p.map being a folder");
+    const char *const allowed[] = {"p.inc", "p.ini", "p.map", "p.csv", "sub", NULL};
+    const char *first;
+    cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "left %s", first);
+    free(prefix);
+    free(csv);
+    free(folder);
+    free(map);
+    free(saved);
+    remove_tree(dir);
+}
+
+/* ---------------------------------------------------------------- info validates as trace */
+
+/* A lens that forms no real image (a biconcave singlet; the double-Gauss with its second
+   index typed 16.99, whose focal length comes out negative) is refused by info exactly as by trace. */
+Test(robustness, info_refuses_the_lenses_trace_refuses_with_the_same_message)
+{
+    static const char *const lenses[] = {
+        "-50 5 1.5 20\n0 5 0 10\n50 0 1 20\n",
+        "29.475 3.76 1.67 25.2\n84.83 0.12 16.99 25.2\n19.275 4.025 1.67 23\n"
+        "40.77 3.275 1.699 23\n12.75 5.705 1 18\n0 4.5 0 17.1\n-14.495 1.18 1.603 17\n"
+        "40.77 6.065 1.658 20\n-20.385 0.19 1 20\n437.065 3.22 1.717 20\n-39.73 0 1 20\n",
+    };
+    for (size_t i = 0; i < sizeof lenses / sizeof lenses[0]; i++) {
+        const char *dir = test_tmpdir();
+        char *lens = strdup(tmp_path(dir, "bad.dat")), *out = strdup(tmp_path(dir, "p"));
+        write_text(lens, lenses[i]);
+        char *info_err = NULL, *trace_err = NULL, *info_out = NULL;
+        const int si = run_lens2pov(&info_out, &info_err, "info", lens, NULL);
+        const int st = run_lens2pov(NULL, &trace_err, "trace", lens, "-o", out, "-q", NULL);
+        cr_expect_eq(si, 2, "lens %zu: info exit %d: %s", i, si, info_out);
+        cr_expect_eq(st, 2, "lens %zu: trace exit %d", i, st);
+        cr_expect_str_eq(info_err, trace_err, "lens %zu", i);
+        cr_expect_not_null(strstr(info_err, "diverges light"), "lens %zu: %s", i, info_err);
+        cr_expect_str_empty(info_out, "lens %zu", i);
+        free(info_err);
+        free(trace_err);
+        free(info_out);
+        free(lens);
+        free(out);
+        remove_tree(dir);
+    }
 }

@@ -72,6 +72,19 @@ int outfile_check_path(const char *path, l2p_error *err)
     return why ? l2p_fail(err, L2P_BAD_INPUT, path, 0, "cannot write: %s", why) : L2P_OK;
 }
 
+int outfile_check_dir(const char *path, l2p_error *err)
+{
+    struct stat sb;
+    if (!*path)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "an output folder name is empty");
+    if (stat(path, &sb) != 0)
+        return outfile_check_path(path, err);   /* to be made: its parent must take it */
+    const char *why = !S_ISDIR(sb.st_mode) ? strerror(ENOTDIR)
+                      : access(path, W_OK | X_OK) != 0 ? strerror(errno)
+                                                        : NULL;
+    return why ? l2p_fail(err, L2P_BAD_INPUT, path, 0, "cannot write: %s", why) : L2P_OK;
+}
+
 int outfile_open(outfile *f, const char *path, l2p_error *err)
 {
     memset(f, 0, sizeof *f);

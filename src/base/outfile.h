@@ -28,6 +28,10 @@ int outfile_create_temp(const char *prefix, const char *suffix, char **path);
    written, and path is not a folder. L2P_BAD_INPUT with a message naming path otherwise. */
 int outfile_check_path(const char *path, l2p_error *err);
 
+/* The same for a folder that is kept or made: an existing one must be a folder that may be
+   written, a new one's parent must exist and may be written. */
+int outfile_check_dir(const char *path, l2p_error *err);
+
 /* Opens a temporary file beside path for writing (outfile_create_temp, "PATH.tmp..."). */
 int outfile_open(outfile *f, const char *path, l2p_error *err);
 

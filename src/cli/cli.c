@@ -13,6 +13,96 @@
 #define MEMORY_MB_MOST 1073741824.0
 #define FILM_PIXELS_MOST 4294967296LL
 
+/* The commands, as bits of the option table. */
+enum { CMD_INFO = 1, CMD_TRACE = 2, CMD_DEVELOP = 4, CMD_RENDER = 8 };
+enum { CMD_CAMERA = CMD_INFO | CMD_TRACE | CMD_RENDER, CMD_SAMPLES = CMD_TRACE | CMD_RENDER };
+
+static unsigned command_bit(const char *name)
+{
+    static const char *const names[] = {"info", "trace", "develop", "render"};
+    for (unsigned i = 0; i < 4; i++)
+        if (!strcmp(name, names[i]))
+            return 1u << i;
+    return 0;
+}
+
+/* Every option, the commands that take it and its line in COMMAND --help: the parser accepts
+   exactly what the help lists. An option whose help differs between commands has a row for
+   each; a row without help is on the line of the row before (--height on --width's). info
+   takes only the camera options that change what it prints. */
+typedef struct cli_option {
+    const char *name, *alias;
+    unsigned commands;
+    bool flag;     /* takes no value */
+    bool camera;   /* listed under "camera options"; info then prints the camera too */
+    const char *help;
+} cli_option;
+
+static const cli_option OPTIONS[] = {
+    {"--json", NULL, CMD_INFO, true, false,
+     "  --json                        JSON instead of text [text]\n"},
+    {"--output", "-o", CMD_TRACE, false, false,
+     "  -o, --output PREFIX           (required)\n"},
+    {"--output", "-o", CMD_DEVELOP, false, false,
+     "  -o, --output IMAGE            (required)\n"},
+    {"--output", "-o", CMD_RENDER, false, false,
+     "  -o, --output IMAGE            .png, .exr or .tif (required)\n"},
+    {"--jobs", NULL, CMD_RENDER, false, false,
+     "  --jobs N                      POV-Ray processes at once [the cores]\n"},
+    {"--memory-mb", NULL, CMD_TRACE, false, false,
+     "  --memory-mb MB                split into chunks that fit a POV-Ray process of\n"
+     "                                this size [one include]\n"},
+    {"--memory-mb", NULL, CMD_RENDER, false, false,
+     "  --memory-mb MB                POV-Ray memory a process [1024]\n"},
+    {"--rays", NULL, CMD_SAMPLES, false, false,
+     "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"},
+    {"--scene", NULL, CMD_TRACE, false, false,
+     "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"},
+    {"--keep-temp", NULL, CMD_RENDER, false, false,
+     "  --keep-temp DIR               keep the ray tables, renders and logs [removed]\n"},
+    {"--quiet", "-q", CMD_TRACE, true, false,
+     "  -q, --quiet                   no progress or summary on stderr\n"},
+    {"--quiet", "-q", CMD_RENDER, true, false,
+     "  -q, --quiet                   no progress on stderr\n"},
+    {"--no-size-check", NULL, CMD_SAMPLES, true, false,
+     "  --no-size-check               go on when the outputs seem not to fit the disk\n"
+     "                                or memory [refuse, naming the estimate]\n"},
+    {"--width", NULL, CMD_CAMERA, false, true,
+     "  --width N --height N          film pixels [640 x 480]\n"},
+    {"--height", NULL, CMD_CAMERA, false, true, NULL},
+    {"--spp", NULL, CMD_SAMPLES, false, true,
+     "  --spp N                       samples per pixel [16]\n"},
+    {"--film-diagonal", NULL, CMD_CAMERA, false, true,
+     "  --film-diagonal MM            [35]\n"},
+    {"--angle", NULL, CMD_CAMERA, false, true,
+     "  --angle DEG|scene             film width for this horizontal field of view, traced\n"
+     "                                (scene: the scene camera's angle) [--film-diagonal]\n"},
+    {"--crop", NULL, CMD_SAMPLES, false, true,
+     "  --crop X0,Y0,X1,Y1            a region of the film (X1, Y1 exclusive) [the whole film]\n"},
+    {"--film-distance", NULL, CMD_CAMERA, false, true,
+     "  --film-distance MM | --focus-distance UNITS|inf\n"
+     "                                [focus on the look-at point]\n"},
+    {"--focus-distance", NULL, CMD_CAMERA, false, true, NULL},
+    {"--aperture-diameter", NULL, CMD_CAMERA, false, true,
+     "  --aperture-diameter MM | --f-number N   [the stop's full opening]\n"},
+    {"--f-number", NULL, CMD_CAMERA, false, true, NULL},
+    {"--pupil", NULL, CMD_CAMERA, false, true,
+     "  --pupil stop-image|rear|stop  [stop-image; stop is a biased diagnostic]\n"},
+    {"--trace", NULL, CMD_CAMERA, false, true,
+     "  --trace full|thick            [full]\n"},
+    {"--weighting", NULL, CMD_SAMPLES, false, true,
+     "  --weighting normalized|physical   [normalized]\n"},
+    {"--location", NULL, CMD_CAMERA, false, true,
+     "  --location X,Y,Z [0,0,0]  --look-at X,Y,Z [0,0,1]  --sky X,Y,Z [0,1,0]\n"
+     "                                [render, trace --scene: the scene's camera]\n"},
+    {"--look-at", NULL, CMD_CAMERA, false, true, NULL},
+    {"--sky", NULL, CMD_CAMERA, false, true, NULL},
+    {"--unit-mm", NULL, CMD_CAMERA, false, true,
+     "  --unit-mm MM                  millimetres in a scene unit [1000]\n"},
+    {"--seed", NULL, CMD_SAMPLES, false, true,
+     "  --seed N                      the sample pattern's seed [0]\n"},
+};
+
 static int bad(l2p_error *err, const char *opt, const char *want, const char *got)
 {
     return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s: expected %s, got '%s'", opt, want, got);
@@ -136,7 +226,6 @@ static int double_in(const char *opt, const char *v, double least, double most, 
 static int film_option(cli *c, const char *opt, const char *v, l2p_error *err)
 {
     camera_options *o = &c->cam;
-    c->film_given = true;
     if (!strcmp(opt, "--width"))
         return positive_int(opt, v, &o->width, err);
     if (!strcmp(opt, "--height"))
@@ -225,7 +314,7 @@ static int place_option(cli *c, const char *opt, const char *v, l2p_error *err)
 
 static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
 {
-    if (!strcmp(opt, "-o") || !strcmp(opt, "--output"))
+    if (!strcmp(opt, "--output"))
         c->output = v;
     else if (!strcmp(opt, "--rays"))
         c->rays_csv = v;
@@ -299,15 +388,37 @@ static int check_contradictions(const cli *c, l2p_error *err)
     return L2P_OK;
 }
 
-static bool is_flag(cli *c, const char *a)
+/* A flag of the table (no value). */
+static void set_flag(cli *c, const cli_option *o)
 {
-    if (!strcmp(a, "--json"))
+    if (!strcmp(o->name, "--json"))
         c->json = true;
-    else if (!strcmp(a, "--quiet") || !strcmp(a, "-q"))
+    else if (!strcmp(o->name, "--quiet"))
         c->quiet = true;
+    else if (!strcmp(o->name, "--no-size-check"))
+        c->no_size_check = true;
+}
+
+/* The option a word names, for this command; NULL with the error set when the command does not
+   take it or no command does. */
+static const cli_option *find_option(unsigned command, const char *cmd_name, const char *opt,
+                                     l2p_error *err)
+{
+    bool known = false;
+    for (size_t i = 0; i < sizeof OPTIONS / sizeof OPTIONS[0]; i++) {
+        const cli_option *o = &OPTIONS[i];
+        if (strcmp(opt, o->name) && !(o->alias && !strcmp(opt, o->alias)))
+            continue;
+        if (o->commands & command)
+            return o;
+        known = true;
+    }
+    if (known)
+        l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s does not take %s (see lens2pov %s --help)",
+                 cmd_name, opt, cmd_name);
     else
-        return false;
-    return true;
+        l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unknown option '%s' (see lens2pov --help)", opt);
+    return NULL;
 }
 
 int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
@@ -315,10 +426,12 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
     memset(c, 0, sizeof *c);
     camera_options_default(&c->cam);
     c->angle_deg = NAN;
+    const char *cmd_name = first > 0 ? argv[first - 1] : "";
+    const unsigned command = command_bit(cmd_name);
+    if (!command)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unknown command '%s' (see --help)", cmd_name);
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
-        if (is_flag(c, a))
-            continue;
         if (a[0] != '-' || a[1] == '\0') {
             if (c->positional_count == CLI_MAX_POSITIONAL)
                 return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unexpected argument '%s'", a);
@@ -327,22 +440,50 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
         }
         const char *eq = strchr(a, '=');
         char opt[64];
-        const char *value;
+        const char *value = NULL;
         if (eq && a[1] == '-' && (size_t)(eq - a) < sizeof opt) {
             memcpy(opt, a, (size_t)(eq - a));
             opt[eq - a] = '\0';
             value = eq + 1;
         } else {
             snprintf(opt, sizeof opt, "%s", a);
+        }
+        const cli_option *o = find_option(command, cmd_name, opt, err);
+        if (!o)
+            return L2P_BAD_INPUT;
+        if (o->flag) {
+            if (value)
+                return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s takes no value", opt);
+            set_flag(c, o);
+            continue;
+        }
+        if (!value) {
             if (i + 1 >= argc)
                 return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s needs a value", opt);
             value = argv[++i];
         }
-        int st = value_option(c, opt, value, err);
+        c->film_given |= o->camera;   /* info prints the camera only when asked for one */
+        int st = value_option(c, o->name, value, err);
         if (st)
             return st;
     }
     return check_contradictions(c, err);
+}
+
+void cli_print_options(FILE *out, const char *command)
+{
+    const unsigned bit = command_bit(command);
+    bool camera_header = false;
+    for (size_t i = 0; i < sizeof OPTIONS / sizeof OPTIONS[0]; i++) {
+        const cli_option *o = &OPTIONS[i];
+        if (!(o->commands & bit) || !o->help)
+            continue;
+        if (o->camera && !camera_header) {
+            fputs("camera options (defaults in brackets):\n", out);
+            camera_header = true;
+        }
+        fputs(o->help, out);
+    }
 }
 
 void cli_warn(const cli *c, const camera *cam)

@@ -4,6 +4,7 @@
 #define LENS2POV_CLI_H
 
 #include <stdbool.h>
+#include <stdio.h>
 #include "camera/camera.h"
 #include "base/error.h"
 
@@ -20,7 +21,8 @@ typedef struct cli {
     double memory_mb;            /* --memory-mb: POV-Ray memory budget per process (chunks) */
     bool json;                   /* --json */
     bool quiet;                  /* --quiet: no progress bar */
-    bool film_given;             /* any film or focus option was given (info prints more) */
+    bool no_size_check;          /* --no-size-check: trace even what seems not to fit */
+    bool film_given;             /* a camera option was given (info prints the camera) */
     bool placed;                 /* --location, --look-at or --sky: the scene's camera is not used */
     const char *scene;           /* trace --scene: the scene whose camera places the lens */
     double angle_deg;            /* --angle: the horizontal field of view; NAN: not given */
@@ -28,8 +30,12 @@ typedef struct cli {
     bool diagonal_given;         /* --film-diagonal (it contradicts --angle) */
 } cli;
 
-/* Parses argv[first..argc-1]. */
+/* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render): an
+   option that command does not take is refused, naming both. */
 int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
+
+/* The lines of COMMAND --help that list its options: the same table the parser accepts. */
+void cli_print_options(FILE *out, const char *command);
 
 /* Warns on stderr about choices that give a picture the user may not expect: --pupil stop
    (biased on purpose), a film distance that puts the focus behind the camera. */

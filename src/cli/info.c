@@ -1,4 +1,5 @@
 #include "cli/info.h"
+#include "optics/focus.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,8 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
     pupil exit;
     double ep_z, ep_r;
     int st = thick_lens_of(&l, 0, l.count - 1, &t, err);
+    if (!st)
+        st = focus_check_real_image(&l, &t, err);   /* as trace's focusing refuses it */
     if (!st)
         st = pupil_stop_image(&l, false, &ep_z, &ep_r, err);
     if (!st)

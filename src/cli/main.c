@@ -11,6 +11,7 @@
 #include "base/outfile.h"
 #include "raytable/raytable.h"
 #include "cli/render.h"
+#include "cli/sizecheck.h"
 
 #define LENS2POV_VERSION "0.4"
 
@@ -24,54 +25,20 @@ static const char usage[] =
     "  lens2pov --version\n"
     "See README.md and docs/ for the conventions.\n";
 
-static const char camera_help[] =
-    "camera options (defaults in brackets):\n"
-    "  --width N --height N          film pixels [640 x 480]\n"
-    "  --spp N                       samples per pixel [16]\n"
-    "  --film-diagonal MM            [35]\n"
-    "  --angle DEG|scene             film width for this horizontal field of view, traced\n"
-    "                                (scene: the scene camera's angle) [--film-diagonal]\n"
-    "  --crop X0,Y0,X1,Y1            a region of the film (X1, Y1 exclusive) [the whole film]\n"
-    "  --film-distance MM | --focus-distance UNITS|inf\n"
-    "                                [focus on the look-at point]\n"
-    "  --aperture-diameter MM | --f-number N   [the stop's full opening]\n"
-    "  --pupil stop-image|rear|stop  [stop-image; stop is a biased diagnostic]\n"
-    "  --trace full|thick            [full]\n"
-    "  --weighting normalized|physical   [normalized]\n"
-    "  --location X,Y,Z [0,0,0]  --look-at X,Y,Z [0,0,1]  --sky X,Y,Z [0,1,0]\n"
-    "                                [render, trace --scene: the scene's camera]\n"
-    "  --unit-mm MM                  millimetres in a scene unit [1000]\n"
-    "  --seed N                      the sample pattern's seed [0]\n";
-
-/* What lens2pov COMMAND --help prints: the command's own lines, then the camera options where
-   it takes them. */
+/* What lens2pov COMMAND --help prints: the command's own lines, then its options from the
+   parser's table (cli_print_options). */
 static const struct {
     const char *name, *text;
-    bool camera;
 } command_help[] = {
     {"info", "usage: lens2pov info LENS [--json] [camera options]\n"
-             "First-order properties of a lens; with camera options also of the camera.\n"
-             "  --json                        JSON instead of text [text]\n", true},
+             "First-order properties of a lens; with camera options also of the camera.\n"},
     {"trace", "usage: lens2pov trace LENS [camera options] -o PREFIX\n"
-              "Traces the film into PREFIX.inc (mesh_camera), PREFIX.ini and PREFIX.map.\n"
-              "  -o, --output PREFIX           (required)\n"
-              "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"
-              "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"
-              "  --memory-mb MB                split into chunks that fit a POV-Ray process of\n"
-              "                                this size [one include]\n"
-              "  -q, --quiet                   no progress or summary on stderr\n", true},
+              "Traces the film into PREFIX.inc (mesh_camera), PREFIX.ini and PREFIX.map.\n"},
     {"develop", "usage: lens2pov develop PREFIX [RENDER.exr ...] -o IMAGE\n"
                 "Weights and averages POV-Ray's renders of PREFIX's ray table into IMAGE\n"
-                "(.png, .exr or .tif) [RENDER.exr: the names PREFIX's .ini files give].\n"
-                "  -o, --output IMAGE            (required)\n", false},
+                "(.png, .exr or .tif) [RENDER.exr: the names PREFIX's .ini files give].\n"},
     {"render", "usage: lens2pov render SCENE.pov LENS [camera options] -o IMAGE\n"
-               "trace, POV-Ray and develop in one, POV-Ray in parallel chunks.\n"
-               "  -o, --output IMAGE            .png, .exr or .tif (required)\n"
-               "  --jobs N                      POV-Ray processes at once [the cores]\n"
-               "  --memory-mb MB                POV-Ray memory a process [1024]\n"
-               "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"
-               "  --keep-temp DIR               keep the ray tables, renders and logs [removed]\n"
-               "  -q, --quiet                   no progress on stderr\n", true},
+               "trace, POV-Ray and develop in one, POV-Ray in parallel chunks.\n"},
 };
 
 /* lens2pov COMMAND ... --help (or -h anywhere after the command): true when printed. */
@@ -83,8 +50,7 @@ static bool print_command_help(int argc, char **argv)
     for (size_t k = 0; asked && k < sizeof command_help / sizeof command_help[0]; k++)
         if (!strcmp(argv[1], command_help[k].name)) {
             fputs(command_help[k].text, stdout);
-            if (command_help[k].camera)
-                fputs(camera_help, stdout);
+            cli_print_options(stdout, command_help[k].name);
             return true;
         }
     return false;
@@ -129,8 +95,11 @@ static int cmd_info(const cli *c, l2p_error *err)
     bool with_camera = c->film_given;
     if (!(st = lens_info_of(&l, &li, err)) && with_camera) {
         lens copy;
+        /* info prints no weights: none to normalize, nothing to refuse for it. */
+        cli physical = *c;
+        physical.cam.weighting = WEIGHTING_PHYSICAL;
         st = lens_copy(&copy, &l) ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
-                                  : framing_camera_setup(&cam, &copy, c, err);
+                                  : framing_camera_setup(&cam, &copy, &physical, err);
         if (st)
             camera_free(&cam);
     }
@@ -144,15 +113,22 @@ static int cmd_info(const cli *c, l2p_error *err)
     return st;
 }
 
-/* trace's outputs, checked before any work: PREFIX.inc stands for the set beside it. */
+/* trace's outputs, checked before any work: PREFIX.inc, .ini and .map (a chunked table's
+   files are checked again before the first is renamed into place). */
 static int check_trace_outputs(const cli *c, l2p_error *err)
 {
-    char *inc = malloc(strlen(c->output) + 5);
-    if (!inc)
+    char *path = malloc(strlen(c->output) + 5);
+    if (!path)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    sprintf(inc, "%s.inc", c->output);
-    int st = outfile_check_path(inc, err);
-    free(inc);
+    static const char *const ext[] = {"inc", "ini", "map"};
+    int st = L2P_OK;
+    for (int i = 0; i < 3 && !st; i++) {
+        sprintf(path, "%s.%s", c->output, ext[i]);
+        st = outfile_check_path(path, err);
+    }
+    free(path);
+    if (!st)
+        st = povmesh_check_prefix(c->output, err);
     if (!st && c->rays_csv)
         st = outfile_check_path(c->rays_csv, err);
     return st;
@@ -164,7 +140,7 @@ static int cmd_trace(const cli *given, l2p_error *err)
     cli placed = *given;   /* with --scene's camera placement */
     const cli *c = &placed;
     int st = need(c, 1, true, err);
-    if (st || (st = check_trace_outputs(c, err)) ||
+    if (st || (st = check_trace_outputs(c, err)) || (st = size_check_trace(c, err)) ||
         (c->scene && (st = framing_from_scene(&placed, c->scene, err))) ||
         (st = load_camera(c, c->positional[0], &cam, err)))
         return st;

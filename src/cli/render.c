@@ -19,7 +19,29 @@
 #include "base/outfile.h"
 #include "povray/povray.h"
 #include "raytable/chunk_name.h"
+#include "cli/sizecheck.h"
 #include "raytable/raytable.h"
+
+static const char *temp_root(void)
+{
+    const char *tmp = getenv("TMPDIR");
+    return tmp && *tmp ? tmp : "/tmp";
+}
+
+/* POV-Ray is given the workspace's files by name (the chunks' .ini and renders), so the
+   workspace (--keep-temp, else under $TMPDIR) must have a name it reads as it is. */
+static int check_workspace_path(const cli *c, l2p_error *err)
+{
+    const char *dir = c->keep_temp ? c->keep_temp : temp_root();
+    char cwd[4096] = "";
+    if (dir[0] != '/' && !getcwd(cwd, sizeof cwd))
+        cwd[0] = '\0';
+    if (povray_path_is_plain(cwd) && povray_path_is_plain(dir))
+        return L2P_OK;
+    return l2p_fail(err, L2P_BAD_INPUT, dir, 0, "POV-Ray 3.7 cannot use this folder for its "
+                    "files (only plain ASCII without '\"' or '\\'): %s",
+                    c->keep_temp ? "give another --keep-temp" : "set TMPDIR to another");
+}
 
 static int check_inputs(const cli *c, l2p_error *err)
 {
@@ -39,7 +61,9 @@ static int check_inputs(const cli *c, l2p_error *err)
     int st = outfile_check_path(c->output, err);
     if (!st && c->rays_csv)
         st = outfile_check_path(c->rays_csv, err);
-    return st;
+    if (!st && c->keep_temp)
+        st = outfile_check_dir(c->keep_temp, err);
+    return st ? st : check_workspace_path(c, err);
 }
 
 /* Chunks small enough for the memory budget, as many as a multiple of the jobs and with the
@@ -100,8 +124,7 @@ static int make_workspace(workspace *w, const cli *c, l2p_error *err)
             return l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "cannot make folder: %s", strerror(errno));
         return L2P_OK;
     }
-    const char *tmp = getenv("TMPDIR");
-    tmp = tmp && *tmp ? tmp : "/tmp";
+    const char *tmp = temp_root();
     remove_stale_workspaces(tmp);
     snprintf(w->dir, sizeof w->dir, "%s/lens2pov.%ld.XXXXXX", tmp, (long)getpid());
     if (!mkdtemp(w->dir))
@@ -319,7 +342,11 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
 
 int render_command(const cli *given, l2p_error *err)
 {
+    const int jobs = given->jobs > 0 ? given->jobs : cores_online();
     int st = check_inputs(given, err);
+    if (!st)
+        st = size_check_render(given, given->keep_temp ? given->keep_temp : temp_root(), jobs,
+                               err);
     if (st)
         return st;
     cli placed = *given;   /* with the scene camera's placement */
@@ -337,7 +364,6 @@ int render_command(const cli *given, l2p_error *err)
     pthread_t loader;
     if (start_thread(&loader, load_image_library, NULL) == 0)
         pthread_detach(loader);   /* image_io_ready waits for it */
-    const int jobs = c->jobs > 0 ? c->jobs : cores_online();
     workspace w;
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&

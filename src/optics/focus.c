@@ -33,6 +33,15 @@ static double axial_image_z(const lens *l, double object_z_mm)
     return r.o.z - r.o.y * r.d.z / r.d.y;
 }
 
+int focus_check_real_image(const lens *l, const thick_lens *t, l2p_error *err)
+{
+    if (!(t->rear_focal_length_mm > 0.0))
+        return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[0].line,
+                        "the lens diverges light (focal length %g mm): it forms no real image",
+                        t->rear_focal_length_mm);
+    return L2P_OK;
+}
+
 /* Newton's x x' = f1 f2 with the lens at film distance d: x = D - (F1_0 + d),
    x' = F2_0 + d. With e = x' and S = D - F1_0 + F2_0: e^2 - S e + f1 f2 = 0, whose smaller
    root e = 2 f1 f2 / (S + sqrt(S^2 - 4 f1 f2)) keeps the film near the rear focal plane. */
@@ -44,10 +53,8 @@ static int thick_estimate(lens *l, double object_mm, double unit_mm, double *d, 
     if (st)
         return st;
     const double ff = t.front_focal_length_mm * t.rear_focal_length_mm;
-    if (!(t.rear_focal_length_mm > 0.0))
-        return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[0].line,
-                        "the lens diverges light (focal length %g mm): it forms no real image",
-                        t.rear_focal_length_mm);
+    if ((st = focus_check_real_image(l, &t, err)) != 0)
+        return st;
     double e = 0.0;
     if (!isinf(object_mm)) {
         const double S = object_mm - t.f1_z_mm + t.f2_z_mm;

@@ -4,6 +4,7 @@
 
 #include "base/error.h"
 #include "optics/lens.h"
+#include "optics/thicklens.h"
 
 /* Sets l's film distance so that the plane object_distance_mm in front of the film (INFINITY
    for infinity) is in paraxial focus on the film: a thick-lens estimate, refined by secant
@@ -11,6 +12,10 @@
    only words messages in scene units. L2P_BAD_INPUT, naming the closest distance, when the
    plane is closer than the lens can focus. */
 int focus_set(lens *l, double object_distance_mm, double unit_mm, l2p_error *err);
+
+/* A lens that diverges light (t: its thick lens, film distance 0) forms no real image:
+   L2P_BAD_INPUT naming the file. Every command refuses such a lens, info as trace. */
+int focus_check_real_image(const lens *l, const thick_lens *t, l2p_error *err);
 
 /* Film plane to the plane conjugate to the film centre at l's film distance, mm; INFINITY
    when the film is in the rear focal plane. Negative for a virtual conjugate. */

@@ -66,14 +66,25 @@ static char *folder_of(const char *abs_path)
     return d;
 }
 
-/* POV-Ray 3.7 reads paths (options and SDL strings alike) as ASCII: other bytes become
-   spaces, and a '"' cannot be quoted. Backslashes are escapes in SDL strings. */
-static bool povray_can_read(const char *path)
+bool povray_path_is_plain(const char *path)
 {
     for (const unsigned char *p = (const unsigned char *)path; *p; p++)
         if (*p < 0x20 || *p > 0x7e || *p == '"' || *p == '\\')
             return false;
     return true;
+}
+
+bool povray_ini_can_carry(const char *path)
+{
+    for (const unsigned char *p = (const unsigned char *)path; *p; p++)
+        if (*p < 0x20 || *p > 0x7e || *p == '"')
+            return false;
+    return true;
+}
+
+bool povray_ini_needs_quotes(const char *path)
+{
+    return strpbrk(path, ";#',") != NULL;
 }
 
 /* ---------------------------------------------------------------- the run's shared state */
@@ -129,7 +140,7 @@ static int out_of_memory(l2p_error *err)
 static int readable_for_povray(run *r, const char *abs_path, const char *name, char **out,
                                l2p_error *err)
 {
-    if (povray_can_read(abs_path))
+    if (povray_path_is_plain(abs_path))
         return (*out = strdup(abs_path)) ? L2P_OK : out_of_memory(err);
     povray_path_link *grown = realloc(r->links, (size_t)(r->link_count + 1) * sizeof *grown);
     if (!grown)
@@ -153,7 +164,7 @@ static int readable_for_povray(run *r, const char *abs_path, const char *name, c
 /* Paths POV-Ray writes to or that lens2pov chose itself cannot be linked around. */
 static int check_plain(const char *path, l2p_error *err)
 {
-    if (povray_can_read(path))
+    if (povray_path_is_plain(path))
         return L2P_OK;
     return l2p_fail(err, L2P_FAILED, path, 0,
                     "POV-Ray 3.7 cannot use this path (only plain ASCII without '\"' or '\\')");

@@ -3,7 +3,20 @@
 #ifndef LENS2POV_POVRAY_H
 #define LENS2POV_POVRAY_H
 
+#include <stdbool.h>
 #include "base/error.h"
+
+/* POV-Ray 3.7 reads paths (options and SDL strings alike) as ASCII: other bytes become
+   spaces, and a '"' cannot be quoted. Backslashes are escapes in SDL strings. True when path
+   can be given to POV-Ray as it is. */
+bool povray_path_is_plain(const char *path);
+
+/* An .ini value (Output_File_Name=PATH) loses the rest of the line at ';' and '#' and cannot
+   hold '\'' or ',' unquoted; quoted it holds them, but never a '"', and other bytes than
+   printable ASCII are turned into spaces or end the value. True when an .ini can name path,
+   quoted where povray_ini_needs_quotes says so. */
+bool povray_ini_can_carry(const char *path);
+bool povray_ini_needs_quotes(const char *path);
 
 typedef struct povray_chunk {
     const char *include_path;  /* the chunk's camera include (PREFIX.cNNN.inc) */

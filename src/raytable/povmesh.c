@@ -3,12 +3,14 @@
 #include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "raytable/chunk_name.h"
 #include "raytable/facelist.h"
 #include "base/outfile.h"
 #include "raytable/povface.h"
 #include "image/samplemap.h"
+#include "povray/povray.h"
 
 enum { MAX_PACKED_WIDTH = 1024, COUNT_FIELD = 20 };
 
@@ -177,17 +179,40 @@ static char *absolute_exr_path(const povmesh_emitter *e, int index)
     return abs;
 }
 
+static int ini_cannot_carry(const char *path, l2p_error *err)
+{
+    return l2p_fail(err, L2P_BAD_INPUT, path, 0, "POV-Ray's .ini cannot name this file (it has "
+                    "a '\"', a control character or a byte beyond ASCII): choose another name");
+}
+
+int povmesh_check_prefix(const char *prefix, l2p_error *err)
+{
+    char cwd[4096];
+    const bool relative = prefix[0] != '/';
+    if (relative && !getcwd(cwd, sizeof cwd))
+        return L2P_OK;   /* absolute_exr_path keeps the name relative too */
+    char *abs = malloc((relative ? strlen(cwd) + 1 : 0) + strlen(prefix) + 1);
+    if (!abs)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    sprintf(abs, "%s%s%s", relative ? cwd : "", relative ? "/" : "", prefix);
+    const int st = povray_ini_can_carry(abs) ? L2P_OK : ini_cannot_carry(abs, err);
+    free(abs);
+    return st;
+}
+
 static int write_ini(povmesh_emitter *e, chunk *ch, int index, long long rows, l2p_error *err)
 {
     char *path = chunk_path(e, index, "ini"), *exr = absolute_exr_path(e, index);
-    int st = path && exr ? outfile_open(&ch->ini, path, err)
-                         : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    int st = !path || !exr ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
+             : !povray_ini_can_carry(exr) ? ini_cannot_carry(exr, err)
+                                          : outfile_open(&ch->ini, path, err);
     if (!st)
         fprintf(ch->ini.fp,
                 "; lens2pov: POV-Ray settings for the ray table beside this file.\n"
                 "; Row 0 of the image repeats row 1 (POV-Ray 3.7.0.10, FS#254): one row more.\n"
                 "Width=%d\nHeight=%lld\nAntialias=Off\nOutput_File_Type=E\nOutput_To_File=On\n"
-                "Output_File_Name=%s\nDisplay=Off\n", e->packed_width, rows + 1, exr);
+                "Output_File_Name=%s%s%s\nDisplay=Off\n", e->packed_width, rows + 1,
+                povray_ini_needs_quotes(exr) ? "\"" : "", exr, povray_ini_needs_quotes(exr) ? "\"" : "");
     free(path);
     free(exr);
     return st ? st : outfile_finish(&ch->ini, err);
@@ -458,9 +483,24 @@ static int finish_all(povmesh_emitter *e, l2p_error *err)
     return st;
 }
 
+/* A target that turned into a folder during the run cannot be renamed onto: found before
+   the first rename, so that the set is replaced whole or not at all. */
+static int check_target(const outfile *f, l2p_error *err)
+{
+    struct stat sb;
+    if (f->temp_path && stat(f->final_path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return l2p_fail(err, L2P_FAILED, f->final_path, 0, "cannot write: Is a directory");
+    return L2P_OK;
+}
+
 static int commit_all(povmesh_emitter *e, l2p_error *err)
 {
-    int st = L2P_OK;
+    int st = check_target(&e->map, err);
+    if (!st && e->has_csv)
+        st = check_target(&e->csv.file, err);
+    for (int i = 0; i < e->chunk_count && !st; i++)
+        if (!e->chunks[i].committed && !(st = check_target(&e->chunks[i].inc.file, err)))
+            st = check_target(&e->chunks[i].ini, err);
     for (int i = 0; i < e->chunk_count && !st; i++)
         if (!e->chunks[i].committed && !(st = outfile_commit(&e->chunks[i].inc.file, err)))
             st = outfile_commit(&e->chunks[i].ini, err);
