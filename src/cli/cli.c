@@ -94,7 +94,7 @@ static const cli_option OPTIONS[] = {
      "  --weighting normalized|physical   [normalized]\n"},
     {"--location", NULL, CMD_CAMERA, false, true,
      "  --location X,Y,Z [0,0,0]  --look-at X,Y,Z [0,0,1]  --sky X,Y,Z [0,1,0]\n"
-     "                                [render, trace --scene: the scene's camera]\n"},
+     "                                [with a scene: the scene's camera]\n"},
     {"--look-at", NULL, CMD_CAMERA, false, true, NULL},
     {"--sky", NULL, CMD_CAMERA, false, true, NULL},
     {"--unit-mm", NULL, CMD_CAMERA, false, true,
