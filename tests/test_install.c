@@ -51,6 +51,13 @@ Test(install, installs_man_page_script_lenses_and_docs_that_work, .timeout = 120
     /* The installed tool, from another folder, on an installed lens. */
     cr_expect_eq(shell("cd / && '%s/bin/lens2pov' info '%s/share/lens2pov/lenses/dgauss.50mm.dat' "
                        ">/dev/null", p, p), 0);
+    /* ... and on a lens given by name, found in the installed lens folder. */
+    cr_expect_eq(shell("cd / && '%s/bin/lens2pov' info dgauss.50mm >'%s/byname.txt'", p, p), 0);
+    char *byname = read_text(tmp_path(p, "byname.txt"), NULL);
+    char where[600];
+    snprintf(where, sizeof where, "%s/share/lens2pov/lenses/dgauss.50mm.dat (", p);
+    cr_expect(byname && strncmp(byname, where, strlen(where)) == 0, "%s", byname ? byname : "");
+    free(byname);
     /* The batch script answers --help with its usage (exit 2, as for a wrong command line). */
     cr_expect_eq(shell("cd / && '%s/bin/lens2pov-render-all' --help 2>'%s/help.txt'; "
                        "test $? -eq 2", p, p), 0);

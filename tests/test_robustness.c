@@ -9,6 +9,7 @@
      themselves are never touched, because they only ever appear by rename(2).
    The fuzz targets (tests/fuzz/) and valgrind (tools/valgrind.sh) cover the rest. */
 #include <criterion/criterion.h>
+#include <criterion/parameterized.h>
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -152,63 +153,69 @@ static const bad_line BAD_OPTIONS[] = {
     {{"info", DGAUSS, "--json=1"}, "--json"},
 };
 
-/* Rows first .. last-1 of the table (the table is split over several tests, which Criterion
-   runs side by side: each row starts lens2pov, about half a second). */
-static void check_bad_options(size_t first, size_t last)
+/* The parameters of a test a row: row numbers, in Criterion's shared memory (a test's process
+   cannot follow the table's pointers, which are the runner's). */
+static void free_rows(struct criterion_test_params *p)
 {
-    const size_t n = sizeof BAD_OPTIONS / sizeof BAD_OPTIONS[0];
-    for (size_t i = first; i < last && i < n; i++) {
-        const bad_line *b = &BAD_OPTIONS[i];
-        const char *dir = test_tmpdir();
-        char out[512], outexr[512], outinc[512], outmap[512], scene[512], jpg[512];
-        snprintf(out, sizeof out, "%s/p", dir);
-        snprintf(outexr, sizeof outexr, "%s/p.exr", dir);
-        snprintf(outinc, sizeof outinc, "%s/p.inc", dir);
-        snprintf(outmap, sizeof outmap, "%s/p.map", dir);
-        snprintf(scene, sizeof scene, "%s/scene.pov", dir);
-        snprintf(jpg, sizeof jpg, "%s/p.jpg", dir);
-        write_text(scene, "#version 3.7;\nbackground { rgb 1 }\n");
-        char *w[16] = {0};
-        char line[1024] = "";
-        for (int k = 0; k < 15 && b->words[k]; k++) {
-            const char *x = b->words[k];
-            w[k] = !strcmp(x, "OUT")       ? out
-                   : !strcmp(x, "OUTEXR")  ? outexr
-                   : !strcmp(x, "OUT.inc") ? outinc
-                   : !strcmp(x, "OUT.map") ? outmap
-                   : !strcmp(x, "OUT.jpg") ? jpg
-                   : !strcmp(x, "SCENE")   ? scene
-                                           : (char *)x;
-            strncat(line, x, sizeof line - strlen(line) - 2);
-            strcat(line, " ");
-        }
-        char *errtext = NULL, *outtext = NULL;
-        const int st = run_lens2pov(&outtext, &errtext, w[0], w[1], w[2], w[3], w[4], w[5], w[6],
-                                    w[7], w[8], w[9], w[10], w[11], w[12], w[13], w[14], NULL);
-        cr_expect_eq(st, 2, "`%s`: exit %d: %s", line, st, errtext);
-        cr_expect(strncmp(errtext, "lens2pov: ", 10) == 0, "`%s`: %s", line, errtext);
-        cr_expect(strchr(errtext, '\n') == errtext + strlen(errtext) - 1,
-                  "`%s`: not one line: %s", line, errtext);
-        cr_expect_not_null(strstr(errtext, b->expect), "`%s`: '%s' not in: %s", line, b->expect,
-                           errtext);
-        cr_expect_str_empty(outtext, "`%s`: wrote to stdout: %s", line, outtext);
-        const char *const allowed[] = {"scene.pov", NULL};
-        const char *first;
-        cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "`%s` left %s", line, first);
-        free(errtext);
-        free(outtext);
-        remove_tree(dir);
-    }
+    cr_free(p->params);
 }
 
-Test(robustness, invalid_sizes_are_refused) { check_bad_options(0, 13); }
-Test(robustness, invalid_film_values_are_refused) { check_bad_options(13, 28); }
-Test(robustness, invalid_aperture_and_names_are_refused) { check_bad_options(28, 37); }
-Test(robustness, contradictory_options_are_refused) { check_bad_options(37, 42); }
-Test(robustness, invalid_placement_is_refused) { check_bad_options(42, 54); }
-Test(robustness, invalid_run_options_and_command_lines_are_refused)
+static struct criterion_test_params row_numbers(size_t n)
 {
-    check_bad_options(54, sizeof BAD_OPTIONS / sizeof BAD_OPTIONS[0]);
+    size_t *rows = cr_malloc(n * sizeof *rows);
+    for (size_t i = 0; i < n; i++)
+        rows[i] = i;
+    return cr_make_param_array(size_t, rows, n, free_rows);
+}
+
+/* One test a row, so that Criterion runs them side by side and names the row that fails. */
+ParameterizedTestParameters(robustness, bad_command_lines_are_refused)
+{
+    return row_numbers(sizeof BAD_OPTIONS / sizeof BAD_OPTIONS[0]);
+}
+
+ParameterizedTest(size_t *row, robustness, bad_command_lines_are_refused)
+{
+    const bad_line *b = &BAD_OPTIONS[*row];
+    const char *dir = test_tmpdir();
+    char out[512], outexr[512], outinc[512], outmap[512], scene[512], jpg[512];
+    snprintf(out, sizeof out, "%s/p", dir);
+    snprintf(outexr, sizeof outexr, "%s/p.exr", dir);
+    snprintf(outinc, sizeof outinc, "%s/p.inc", dir);
+    snprintf(outmap, sizeof outmap, "%s/p.map", dir);
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(jpg, sizeof jpg, "%s/p.jpg", dir);
+    write_text(scene, "#version 3.7;\nbackground { rgb 1 }\n");
+    char *w[16] = {0};
+    char line[1024] = "";
+    for (int k = 0; k < 15 && b->words[k]; k++) {
+        const char *x = b->words[k];
+        w[k] = !strcmp(x, "OUT")       ? out
+               : !strcmp(x, "OUTEXR")  ? outexr
+               : !strcmp(x, "OUT.inc") ? outinc
+               : !strcmp(x, "OUT.map") ? outmap
+               : !strcmp(x, "OUT.jpg") ? jpg
+               : !strcmp(x, "SCENE")   ? scene
+                                       : (char *)x;
+        strncat(line, x, sizeof line - strlen(line) - 2);
+        strcat(line, " ");
+    }
+    char *errtext = NULL, *outtext = NULL;
+    const int st = run_lens2pov(&outtext, &errtext, w[0], w[1], w[2], w[3], w[4], w[5], w[6],
+                                w[7], w[8], w[9], w[10], w[11], w[12], w[13], w[14], NULL);
+    cr_expect_eq(st, 2, "`%s`: exit %d: %s", line, st, errtext);
+    cr_expect(strncmp(errtext, "lens2pov: ", 10) == 0, "`%s`: %s", line, errtext);
+    cr_expect(strchr(errtext, '\n') == errtext + strlen(errtext) - 1,
+              "`%s`: not one line: %s", line, errtext);
+    cr_expect_not_null(strstr(errtext, b->expect), "`%s`: '%s' not in: %s", line, b->expect,
+                       errtext);
+    cr_expect_str_empty(outtext, "`%s`: wrote to stdout: %s", line, outtext);
+    const char *const allowed[] = {"scene.pov", NULL};
+    const char *first;
+    cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "`%s` left %s", line, first);
+    free(errtext);
+    free(outtext);
+    remove_tree(dir);
 }
 
 /* ---------------------------------------------------------------- malformed lens files */
@@ -256,60 +263,56 @@ static const bad_lens BAD_LENSES[] = {
     {"1e-307 1e-307 1 1e-307\n0 1e-307 0 1e-307\n-1e-307 0 1.5 1e-307\n", 0, -1, ""},
 };
 
-/* Rows with line -1: refused with exit 2 and FILE:LINE for some line of the file. Rows
-   first .. last-1; `info` reads the lens the same way as `trace` and is run on the rows the
-   optics refuse (where the two commands go through different code). */
-static void check_bad_lenses(size_t first, size_t last)
+/* Rows with line -1: refused with exit 2 and FILE:LINE for some line of the file. `info`
+   reads the lens the same way as `trace` and is run on the rows the optics refuse (where the
+   two commands go through different code). One test a row. */
+ParameterizedTestParameters(robustness, bad_lens_files_are_refused_with_their_line)
 {
-    const size_t n = sizeof BAD_LENSES / sizeof BAD_LENSES[0];
-    for (size_t i = first; i < last && i < n; i++) {
-        const bad_lens *b = &BAD_LENSES[i];
-        const char *dir = test_tmpdir();
-        char lens_path[512], out[512], csv[512];
-        snprintf(lens_path, sizeof lens_path, "%s/bad.dat", dir);
-        snprintf(out, sizeof out, "%s/p", dir);
-        snprintf(csv, sizeof csv, "%s/p.csv", dir);
-        FILE *f = fopen(lens_path, "wb");
-        cr_assert_not_null(f);
-        fwrite(b->text, 1, b->length ? (size_t)b->length : strlen(b->text), f);
-        fclose(f);
-        for (int cmd = b->line >= 0 && b->line <= 1 ? 1 : 0; cmd < 2; cmd++) {
-            char *errtext = NULL;
-            const int st = cmd == 0
-                               ? run_lens2pov(NULL, &errtext, "info", lens_path, "--json", NULL)
-                               : run_lens2pov(NULL, &errtext, "trace", lens_path, "--width", "8",
-                                              "--height", "6", "--spp", "1", "--rays", csv, "-o",
-                                              out, "--quiet", NULL);
-            cr_expect_eq(st, 2, "lens %zu (%s): exit %d: %s", i, cmd ? "trace" : "info", st,
-                         errtext);
-            char where[600];
-            if (b->line > 0)
-                snprintf(where, sizeof where, "lens2pov: %s:%d: ", lens_path, b->line);
-            else
-                snprintf(where, sizeof where, "lens2pov: %s:", lens_path);
-            cr_expect(strncmp(errtext, where, strlen(where)) == 0, "lens %zu: '%s' expected in: %s",
-                      i, where, errtext);
-            if (b->line < 0) {
-                /* Some line: "FILE:N: " with N a number. */
-                const char *p = errtext + strlen(where);
-                cr_expect(*p >= '1' && *p <= '9', "lens %zu: no line in: %s", i, errtext);
-            }
-            cr_expect_not_null(strstr(errtext, b->expect), "lens %zu: '%s' not in: %s", i,
-                               b->expect, errtext);
-            free(errtext);
-        }
-        const char *const allowed[] = {"bad.dat", NULL};
-        const char *left;
-        cr_expect_eq(unexpected_files(dir, allowed, &left), 0, "lens %zu left %s", i, left);
-        remove_tree(dir);
-    }
+    return row_numbers(sizeof BAD_LENSES / sizeof BAD_LENSES[0]);
 }
 
-Test(robustness, malformed_rows_are_refused_with_their_line) { check_bad_lenses(0, 12); }
-Test(robustness, malformed_values_are_refused_with_their_line) { check_bad_lenses(12, 24); }
-Test(robustness, lenses_the_optics_cannot_use_are_refused_with_a_line)
+ParameterizedTest(size_t *row, robustness, bad_lens_files_are_refused_with_their_line)
 {
-    check_bad_lenses(24, sizeof BAD_LENSES / sizeof BAD_LENSES[0]);
+    const size_t i = *row;
+    const bad_lens *b = &BAD_LENSES[i];
+    const char *dir = test_tmpdir();
+    char lens_path[512], out[512], csv[512];
+    snprintf(lens_path, sizeof lens_path, "%s/bad.dat", dir);
+    snprintf(out, sizeof out, "%s/p", dir);
+    snprintf(csv, sizeof csv, "%s/p.csv", dir);
+    FILE *f = fopen(lens_path, "wb");
+    cr_assert_not_null(f);
+    fwrite(b->text, 1, b->length ? (size_t)b->length : strlen(b->text), f);
+    fclose(f);
+    for (int cmd = b->line >= 0 && b->line <= 1 ? 1 : 0; cmd < 2; cmd++) {
+        char *errtext = NULL;
+        const int st = cmd == 0
+                           ? run_lens2pov(NULL, &errtext, "info", lens_path, "--json", NULL)
+                           : run_lens2pov(NULL, &errtext, "trace", lens_path, "--width", "8",
+                                          "--height", "6", "--spp", "1", "--rays", csv, "-o",
+                                          out, "--quiet", NULL);
+        cr_expect_eq(st, 2, "lens %zu (%s): exit %d: %s", i, cmd ? "trace" : "info", st,
+                     errtext);
+        char where[600];
+        if (b->line > 0)
+            snprintf(where, sizeof where, "lens2pov: %s:%d: ", lens_path, b->line);
+        else
+            snprintf(where, sizeof where, "lens2pov: %s:", lens_path);
+        cr_expect(strncmp(errtext, where, strlen(where)) == 0, "lens %zu: '%s' expected in: %s",
+                  i, where, errtext);
+        if (b->line < 0) {
+            /* Some line: "FILE:N: " with N a number. */
+            const char *p = errtext + strlen(where);
+            cr_expect(*p >= '1' && *p <= '9', "lens %zu: no line in: %s", i, errtext);
+        }
+        cr_expect_not_null(strstr(errtext, b->expect), "lens %zu: '%s' not in: %s", i,
+                           b->expect, errtext);
+        free(errtext);
+    }
+    const char *const allowed[] = {"bad.dat", NULL};
+    const char *left;
+    cr_expect_eq(unexpected_files(dir, allowed, &left), 0, "lens %zu left %s", i, left);
+    remove_tree(dir);
 }
 
 /* A missing lens file, a folder and an unreadable file: exit 2 and the path. */

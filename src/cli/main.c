@@ -5,6 +5,7 @@
 #include "camera/camera.h"
 #include "base/cleanup.h"
 #include "cli/cli.h"
+#include "cli/lens_lookup.h"
 #include "image/develop.h"
 #include "cli/framing.h"
 #include "cli/info.h"
@@ -75,7 +76,7 @@ static int need(const cli *c, int positional, bool output, l2p_error *err)
 static int load_camera(const cli *c, const char *lens_path, camera *cam, l2p_error *err)
 {
     lens l;
-    int st = lens_read(lens_path, &l, err);
+    int st = lens_read_named(lens_path, &l, err);
     if (st)
         return st;
     st = framing_camera_setup(cam, &l, c, err);
@@ -88,7 +89,7 @@ static int cmd_info(const cli *c, l2p_error *err)
 {
     int st = need(c, 1, false, err);
     lens l;
-    if (st || (st = lens_read(c->positional[0], &l, err)))
+    if (st || (st = lens_read_named(c->positional[0], &l, err)))
         return st;
     lens_info li;
     camera cam;

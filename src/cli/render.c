@@ -14,6 +14,7 @@
 #include "base/cores.h"
 #include "camera/camera.h"
 #include "cli/framing.h"
+#include "cli/lens_lookup.h"
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "base/outfile.h"
@@ -353,7 +354,7 @@ int render_command(const cli *given, l2p_error *err)
     const cli *c = &placed;
     lens l;
     if ((st = framing_from_scene(&placed, c->positional[0], err)) ||
-        (st = lens_read(c->positional[1], &l, err)))
+        (st = lens_read_named(c->positional[1], &l, err)))
         return st;
     camera cam;
     if ((st = framing_camera_setup(&cam, &l, c, err))) {

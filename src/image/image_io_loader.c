@@ -9,6 +9,7 @@
    - in ../lib/lens2pov/ from the executable's folder: where `make install` puts it. */
 #include "image/image_io.h"
 #include "image/image_io_impl.h"
+#include "base/exe_dir.h"
 
 #include <dlfcn.h>
 #include <errno.h>
@@ -79,25 +80,6 @@ static bool try_load(const char *path)
     return true;
 }
 
-/* The executable's folder into dir (resolved, so that a symlinked lens2pov still finds its
-   library); false when /proc/self/exe cannot be read. */
-static bool executable_folder(char *dir, size_t size)
-{
-    const ssize_t n = readlink("/proc/self/exe", dir, size);
-    if (n <= 0 || (size_t)n >= size) {
-        note_failure("/proc/self/exe", n < 0 ? strerror(errno) : "path too long");
-        return false;
-    }
-    dir[n] = '\0';
-    char *slash = strrchr(dir, '/');
-    if (!slash) {
-        note_failure("/proc/self/exe", "not an absolute path");
-        return false;
-    }
-    *slash = '\0';
-    return true;
-}
-
 static void load_bridge(void)
 {
     const char *forced = getenv("LENS2POV_IMAGE_IO");
@@ -110,8 +92,11 @@ static void load_bridge(void)
         return;
     }
     char dir[PATH_MAX], path[PATH_MAX + 64];
-    if (!executable_folder(dir, sizeof dir))
+    const char *why;
+    if (!exe_dir(dir, sizeof dir, &why)) {
+        note_failure("/proc/self/exe", why);
         return;
+    }
     snprintf(path, sizeof path, "%s/" IMAGE_IO_LIBRARY, dir);
     if (try_load(path))
         return;
