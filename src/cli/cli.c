@@ -499,3 +499,13 @@ void cli_warn(const cli *c, const camera *cam)
                         "rays the lens passes: the picture comes out too dark (a diagnostic; "
                         "stop-image and rear are unbiased)\n");
 }
+
+int cli_expect_arguments(const cli *c, int positional, bool output, l2p_error *err)
+{
+    if (c->positional_count != positional)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "expected %d argument%s, got %d (see --help)",
+                        positional, positional == 1 ? "" : "s", c->positional_count);
+    if (output && !c->output)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "-o is required");
+    return L2P_OK;
+}

@@ -41,4 +41,7 @@ void cli_print_options(FILE *out, const char *command);
    (biased on purpose), a film distance that puts the focus behind the camera. */
 void cli_warn(const cli *c, const camera *cam);
 
+/* L2P_BAD_INPUT unless c has exactly `positional` arguments and, when output, a -o. */
+int cli_expect_arguments(const cli *c, int positional, bool output, l2p_error *err);
+
 #endif

@@ -1,4 +1,5 @@
 #include "cli/framing.h"
+#include "cli/lens_lookup.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -105,5 +106,17 @@ int framing_camera_setup(camera *cam, lens *l, const cli *c, l2p_error *err)
     }
     const int st = solve_film(cam, l, c, err);
     lens_free(l);
+    return st;
+}
+
+int framing_load_camera(const cli *c, const char *lens_name, camera *cam, l2p_error *err)
+{
+    lens l;
+    int st = lens_read_named(lens_name, &l, err);
+    if (st)
+        return st;
+    st = framing_camera_setup(cam, &l, c, err);
+    if (st)
+        camera_free(cam);
     return st;
 }

@@ -13,10 +13,12 @@
    on the look_at point. */
 int framing_from_scene(cli *c, const char *scene, l2p_error *err);
 
-
-
 /* camera_setup for the command line: with --angle, the film diagonal that makes the lens's
    horizontal field of view, traced with real rays at the focus in effect, the angle asked
    (the film keeps its aspect); L2P_BAD_INPUT when the lens cannot reach it. Takes the lens. */
 int framing_camera_setup(camera *cam, lens *l, const cli *c, l2p_error *err);
+
+/* framing_camera_setup of the lens found by name or path (cli/lens_lookup.h). */
+int framing_load_camera(const cli *c, const char *lens_name, camera *cam, l2p_error *err);
+
 #endif

@@ -1,5 +1,8 @@
 #include "cli/info.h"
 #include "optics/focus.h"
+#include "cli/commands.h"
+#include "cli/framing.h"
+#include "cli/lens_lookup.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -125,4 +128,33 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, 
     print_fields(out, f, n, json);
     if (json)
         fprintf(out, "}\n");
+}
+
+int info_command(const cli *c, l2p_error *err)
+{
+    int st = cli_expect_arguments(c, 1, false, err);
+    lens l;
+    if (st || (st = lens_read_named(c->positional[0], &l, err)))
+        return st;
+    lens_info li;
+    camera cam;
+    bool with_camera = c->film_given;
+    if (!(st = lens_info_of(&l, &li, err)) && with_camera) {
+        lens copy;
+        /* info prints no weights: none to normalize, nothing to refuse for it. */
+        cli physical = *c;
+        physical.cam.weighting = WEIGHTING_PHYSICAL;
+        st = lens_copy(&copy, &l) ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
+                                  : framing_camera_setup(&cam, &copy, &physical, err);
+        if (st)
+            camera_free(&cam);
+    }
+    if (!st && with_camera)
+        cli_warn(c, &cam);
+    if (!st)
+        info_print(stdout, &l, &li, with_camera ? &cam : NULL, c->json);
+    if (with_camera && !st)
+        camera_free(&cam);
+    lens_free(&l);
+    return st;
 }

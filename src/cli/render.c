@@ -1,4 +1,4 @@
-#include "cli/render.h"
+#include "cli/commands.h"
 
 #include <errno.h>
 #include <pthread.h>

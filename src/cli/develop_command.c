@@ -1,0 +1,62 @@
+/* `lens2pov develop`: POV-Ray's renders of a ray table into the picture. */
+#include "cli/commands.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/outfile.h"
+#include "image/develop.h"
+#include "image/samplemap.h"
+#include "raytable/chunk_name.h"
+#include "raytable/povmesh.h"
+
+/* The renders of the chunks: as given, or by the names the chunks' .ini files give POV-Ray
+   (PREFIX.exr, or PREFIX.c000.exr, PREFIX.c001.exr, ...). */
+static char **render_names(const cli *c, long long chunks, l2p_error *err)
+{
+    const char *prefix = c->positional[0];
+    const long long given = c->positional_count - 1;
+    if (given && given != chunks) {
+        l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s.map has %lld chunk%s but %lld render%s given",
+                 prefix, chunks, chunks == 1 ? "" : "s", given, given == 1 ? " was" : "s were");
+        return NULL;
+    }
+    char **names = calloc((size_t)chunks, sizeof *names);
+    for (long long k = 0; names && k < chunks; k++) {
+        names[k] = given        ? strdup(c->positional[k + 1])
+                   : chunks == 1 ? povmesh_chunk_file(prefix, false, 0, "exr")
+                                 : chunk_file_name(prefix, (int)k, "exr");
+        if (!names[k])
+            break;
+    }
+    return names;
+}
+
+int develop_command(const cli *c, l2p_error *err)
+{
+    if (c->positional_count < 1 || !c->output)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "develop takes PREFIX [RENDER.exr ...] -o IMAGE");
+    int st = outfile_check_path(c->output, err);
+    if (st)
+        return st;
+    char *map_path = malloc(strlen(c->positional[0]) + 8);
+    if (!map_path)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    sprintf(map_path, "%s.map", c->positional[0]);
+    samplemap map;
+    st = samplemap_read(map_path, &map, err);
+    free(map_path);
+    if (st)
+        return st;
+    const long long chunks = samplemap_chunk_count(&map.header);
+    char **names = render_names(c, chunks, err);
+    if (names)
+        st = develop_files(&map, (const char *const *)names, (int)chunks, c->output, err);
+    else
+        st = err->status;
+    for (long long k = 0; names && k < chunks; k++)
+        free(names[k]);
+    free(names);
+    samplemap_free(&map);
+    return st;
+}

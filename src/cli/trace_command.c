@@ -1,0 +1,57 @@
+/* `lens2pov trace`: the ray table of a lens and camera, for POV-Ray. */
+#include "cli/commands.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/outfile.h"
+#include "cli/framing.h"
+#include "cli/sizecheck.h"
+#include "raytable/povmesh.h"
+#include "raytable/raytable.h"
+
+/* trace's outputs, checked before any work: PREFIX.inc, .ini and .map (a chunked table's
+   files are checked again before the first is renamed into place). */
+static int check_trace_outputs(const cli *c, l2p_error *err)
+{
+    char *path = malloc(strlen(c->output) + 5);
+    if (!path)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    static const char *const ext[] = {"inc", "ini", "map"};
+    int st = L2P_OK;
+    for (int i = 0; i < 3 && !st; i++) {
+        sprintf(path, "%s.%s", c->output, ext[i]);
+        st = outfile_check_path(path, err);
+    }
+    free(path);
+    if (!st)
+        st = povmesh_check_prefix(c->output, err);
+    if (!st && c->rays_csv)
+        st = outfile_check_path(c->rays_csv, err);
+    return st;
+}
+
+int trace_command(const cli *given, l2p_error *err)
+{
+    camera cam;
+    cli placed = *given;   /* with --scene's camera placement */
+    const cli *c = &placed;
+    int st = cli_expect_arguments(c, 1, true, err);
+    if (st || (st = check_trace_outputs(c, err)) || (st = size_check_trace(c, err)) ||
+        (c->scene && (st = framing_from_scene(&placed, c->scene, err))) ||
+        (st = framing_load_camera(c, c->positional[0], &cam, err)))
+        return st;
+    cli_warn(c, &cam);
+    raytable_stats stats;
+    /* One include unless --memory-mb asks for chunks that fit a POV-Ray process each. */
+    const long long chunk_faces = c->memory_mb > 0 ? raytable_faces_for_memory(c->memory_mb) : 0;
+    const raytable_request q = {c->output, c->rays_csv, chunk_faces, !c->quiet, NULL};
+    st = raytable_write(&cam, &q, &stats, err);
+    if (!st && !c->quiet)
+        fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%), %.2f s\n",
+                stats.passed, stats.samples,
+                stats.samples ? 100.0 * (double)stats.passed / (double)stats.samples : 0.0,
+                stats.seconds);
+    camera_free(&cam);
+    return st;
+}
