@@ -1,6 +1,6 @@
 /* The full simulation over lanes of rays side by side: trace_kernel.h over vector registers,
-   driven over a batch (trace_soa). One ray alone is a chain of divisions and square roots of
-   some 200 cycles a surface; independent rays side by side keep the processor busy.
+   driven over a batch (trace_soa). One ray alone is a chain of divisions and square roots,
+   each waiting on the one before; independent rays side by side keep the processor busy.
 
    The includer (one file per instruction set) defines trace_kernel.h's operations over
    LANES doubles, load and store of LANES doubles, and names the entry point with

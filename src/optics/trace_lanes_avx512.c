@@ -1,5 +1,6 @@
 /* The lane tracer with AVX-512F: 32 rays a step as four registers of eight (two registers
-   leave the square roots' latency exposed: 20% slower), masks in mask registers. Chosen at run
+   leave the square roots' latency exposed), masks in mask registers: the operations of
+   trace_kernel.h, then the driver of trace_lanes.h. Chosen at run
    time (trace_batch.c); no FMA, as in trace_lanes_avx2.c. */
 #include "optics/trace_lanes_isa.h"
 

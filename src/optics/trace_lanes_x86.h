@@ -1,4 +1,4 @@
-/* The vector primitives of trace_lanes.h for SSE2 and AVX: VECS registers of WIDTH doubles,
+/* The operations of trace_kernel.h for SSE2 and AVX: VECS registers of WIDTH doubles,
    masks kept as all-ones or all-zero doubles. The includer defines
      VECS, WIDTH, reg    register count, doubles a register, the register type
      R(op)               the intrinsic _mm_<op>_pd or _mm256_<op>_pd
