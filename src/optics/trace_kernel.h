@@ -83,6 +83,15 @@ INLINE vmask intersect(const lens_surface *s, const vreal o[3], const vreal d[3]
     return mand(ge(disc, zero), mor(lo_ok, hi_ok));
 }
 
+/* The normal (c x, c y, 1 + c s) at the point h of surface s, in local coordinates. */
+INLINE void normal_at(const lens_surface *s, const vreal h[3], vreal n[3])
+{
+    const vreal c = splat(s->curvature_per_mm);
+    n[0] = mul(c, h[0]);
+    n[1] = mul(c, h[1]);
+    n[2] = add(splat(1), mul(c, h[2]));
+}
+
 /* Refraction of d from index n1 to n2 at the normal n (either orientation), Heckbert's form:
    d' = eta d + (eta cos_i - cos_t) n with eta = n1 / n2. d' goes to e; *tir gets the lanes
    totally reflected, *grazing those within a hair of grazing (TRACE_GRAZING_COS, trace.h).
@@ -134,9 +143,9 @@ INLINE unsigned cross(const lens_surface *s, real a2, real eta, vreal o[3], vrea
     unsigned tir = 0, grazing = 0;
     const bool refracts = eta != 1;
     if (refracts) {
-        const vreal c = splat(s->curvature_per_mm);
-        const vreal n[3] = {mul(c, h[0]), mul(c, h[1]), add(splat(1), mul(c, h[2]))};
+        vreal n[3];
         vmask t, g;
+        normal_at(s, h, n);
         refract(n, splat(eta), d, e, &t, &g);
         tir = bits(t);
         grazing = bits(g);

@@ -42,16 +42,16 @@ INLINE vreal neg(vreal a) { return -a; }
 static trace_status KNAME(intersect)(const lens_surface *s, KRAY *r, KVEC *normal)
 {
     const vreal o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
-    vreal h[3];
+    vreal h[3], n[3];
     if (!intersect(s, o, d, h))
         return TRACE_MISSED;
-    const real c = s->curvature_per_mm;
+    normal_at(s, h, n);
     r->o.x = h[0];
     r->o.y = h[1];
     r->o.z = h[2] + (real)s->vertex_z_mm;
-    normal->x = c * h[0];
-    normal->y = c * h[1];
-    normal->z = 1 + c * h[2];
+    normal->x = n[0];
+    normal->y = n[1];
+    normal->z = n[2];
     return TRACE_PASSED;
 }
 
