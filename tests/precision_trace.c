@@ -2,13 +2,17 @@
    compiled with the test suite's flags; it has no tests of its own. */
 #include "precision_trace.h"
 
+#include <float.h>
 #include <math.h>
 
 #define KREAL long double
+#define KREAL_MAX LDBL_MAX
 #define KVEC ld_vec
 #define KRAY ld_ray
 #define KNAME(f) ld_##f
-#include "optics/trace_kernel.h"
+#include "optics/trace_one.h"
+
+static long double ld_dot(ld_vec a, ld_vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 trace_status precision_trace_range(const lens *l, int first, int last, bool toward_scene,
                                    ld_ray *r, int *blocked_at)

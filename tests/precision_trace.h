@@ -1,5 +1,5 @@
-/* A precision reference for the full simulation: src/optics/trace_kernel.h built a second time with
-   long double (x87 extended: a 64-bit significand, 11 more bits than double), over the same
+/* A precision reference for the full simulation: src/optics/trace_kernel.h built a second
+   time, through trace_one.h, with long double (x87 extended: a 64-bit significand, 11 more bits than double), over the same
    lens description. The double tracer and this one run the same formulas in the same order on
    the same inputs (the lens's numbers are doubles, exact in both), so the difference of their
    results is the rounding error of the double tracer, to within 2^-11 of itself. */

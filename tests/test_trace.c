@@ -144,6 +144,10 @@ Test(trace, apertures_clip)
     ray r = {v3(0, 0, 0), v3_normalize(v3(0, 0.2, 1))};
     cr_assert_eq(trace_toward_scene(&l, 0, l.count - 1, &r, &at), TRACE_CLIPPED);
     cr_assert_eq(at, l.stop, "the small stop blocks it, not a lens element");
+    ray behind = {v3(0, 0, 0), v3_normalize(v3(0, 0.2, 1))};
+    cr_assert_eq(trace_toward_scene(&l, l.stop + 1, l.count - 1, &behind, NULL), TRACE_PASSED);
+    cr_assert(r.o.x == behind.o.x && r.o.y == behind.o.y && r.o.z == behind.o.z,
+              "a blocked ray stays on the last surface it crossed");
     lens_free(&l);
 }
 
@@ -184,8 +188,14 @@ static int check_batch(const lens *l, const char *name, int n, int *traced)
         const trace_status st = trace_toward_scene(l, 0, l->count - 1, &single[k], NULL);
         cr_assert_eq(b.status[k], st, "%s, %s n %d ray %d: status %lld against %d",
                      trace_soa_isa(), name, n, k, b.status[k], st);
-        if (st != TRACE_PASSED)
+        if (st != TRACE_PASSED) {
+            /* Left on the last surface crossed by both (only passing rays are renormalized). */
+            const double got_o[3] = {b.ox[k], b.oy[k], b.oz[k]};
+            const double want_o[3] = {single[k].o.x, single[k].o.y, single[k].o.z};
+            cr_assert(memcmp(got_o, want_o, sizeof got_o) == 0, "%s, %s n %d blocked ray %d differs",
+                      trace_soa_isa(), name, n, k);
             continue;
+        }
         passed++;
         const double got[6] = {b.ox[k], b.oy[k], b.oz[k], b.dx[k], b.dy[k], b.dz[k]};
         const double want[6] = {single[k].o.x, single[k].o.y, single[k].o.z,

@@ -1,11 +1,15 @@
 #include "optics/trace.h"
 
-/* The kernel in double precision; tests/precision_trace.c builds it in long double. */
+#include <float.h>
+
+/* The kernel for one ray in double precision; tests/precision_trace.c builds it in long
+   double. */
 #define KREAL double
+#define KREAL_MAX DBL_MAX
 #define KVEC vec3
 #define KRAY ray
 #define KNAME(f) kernel_##f
-#include "optics/trace_kernel.h"
+#include "optics/trace_one.h"
 
 trace_status trace_intersect(const lens_surface *s, ray *r, vec3 *normal)
 {
@@ -26,4 +30,3 @@ trace_status trace_toward_film(const lens *l, int first, int last, ray *r, int *
 {
     return kernel_through(l, first, last, false, r, blocked_at);
 }
-

@@ -41,7 +41,8 @@ trace_status trace_refract(vec3 n, double n1, double n2, vec3 *d);
 
 /* Traces r through surfaces last, last-1, ..., first (toward the scene, +z), or first .. last
    (toward the film); surfaces outside the range are ignored. Returns TRACE_PASSED with r on
-   the last surface crossed, or why it was blocked, with *blocked_at the surface (may be NULL). */
+   the last surface, or why it was blocked, with *blocked_at the surface (may be NULL) and r
+   left on the last surface it crossed. */
 trace_status trace_toward_scene(const lens *l, int first, int last, ray *r, int *blocked_at);
 trace_status trace_toward_film(const lens *l, int first, int last, ray *r, int *blocked_at);
 

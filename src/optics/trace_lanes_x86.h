@@ -1,4 +1,4 @@
-/* The vector primitives of trace_lanes.h for SSE2 and AVX: VECS registers of WIDTH doubles,
+/* The operations of trace_kernel.h for SSE2 and AVX: VECS registers of WIDTH doubles,
    masks kept as all-ones or all-zero doubles. The includer defines
      VECS, WIDTH, reg    register count, doubles a register, the register type
      R(op)               the intrinsic _mm_<op>_pd or _mm256_<op>_pd
@@ -7,14 +7,14 @@
 #include <stdint.h>
 
 #define LANES (VECS * WIDTH)
-typedef struct vd { reg p[VECS]; } vd;
-typedef vd vm;
+typedef struct vreal { reg p[VECS]; } vreal;
+typedef vreal vmask;
 
 #define UNROLL _Pragma("GCC unroll 4")
 #define BINARY(name, expr)                                                                \
-    INLINE vd name(vd a, vd b)                                                            \
+    INLINE vreal name(vreal a, vreal b)                                                            \
     {                                                                                     \
-        vd r;                                                                             \
+        vreal r;                                                                             \
         UNROLL for (int i = 0; i < VECS; i++) r.p[i] = expr(a.p[i], b.p[i]);              \
         return r;                                                                         \
     }
@@ -33,33 +33,33 @@ BINARY(gt, CMP_GT)
 BINARY(ge, CMP_GE)
 BINARY(ne, CMP_NE)
 
-INLINE vd splat(double x)
+INLINE vreal splat(double x)
 {
-    vd r;
+    vreal r;
     UNROLL for (int i = 0; i < VECS; i++) r.p[i] = R(set1)(x);
     return r;
 }
 
-INLINE vd vsqrt(vd a)
+INLINE vreal vsqrt(vreal a)
 {
-    vd r;
+    vreal r;
     UNROLL for (int i = 0; i < VECS; i++) r.p[i] = R(sqrt)(a.p[i]);
     return r;
 }
 
-INLINE vd load(const double *x)
+INLINE vreal load(const double *x)
 {
-    vd r;
+    vreal r;
     UNROLL for (int i = 0; i < VECS; i++) r.p[i] = R(loadu)(x + WIDTH * i);
     return r;
 }
 
-INLINE void store(double *x, vd v)
+INLINE void store(double *x, vreal v)
 {
     UNROLL for (int i = 0; i < VECS; i++) R(storeu)(x + WIDTH * i, v.p[i]);
 }
 
-INLINE unsigned bits(vm m)
+INLINE unsigned bits(vmask m)
 {
     unsigned r = 0;
     UNROLL for (int i = 0; i < VECS; i++) r |= (unsigned)R(movemask)(m.p[i]) << (WIDTH * i);
@@ -78,17 +78,17 @@ static const uint64_t lane_masks[1 << WIDTH][WIDTH] __attribute__((aligned(32)))
 #endif
 };
 
-INLINE vm mask_of(unsigned lanes)
+INLINE vmask mask_of(unsigned lanes)
 {
-    vm r;
+    vmask r;
     UNROLL for (int i = 0; i < VECS; i++)
         r.p[i] = R(load)((const double *)lane_masks[lanes >> (WIDTH * i) & ((1 << WIDTH) - 1)]);
     return r;
 }
 
-INLINE vm mand(vm a, vm b) { return vand(a, b); }
-INLINE vm mor(vm a, vm b) { return vor(a, b); }
-INLINE vd pick(vm m, vd a, vd b) { return vor(vand(m, a), vandnot(m, b)); }
-INLINE vd neg(vd x) { return vxor(x, splat(-0.0)); }   /* C's -x: flips the sign, also of 0 */
-INLINE vd vabs(vd x) { return vandnot(splat(-0.0), x); }
-INLINE vd vcopysign(vd x, vd y) { return vor(vandnot(splat(-0.0), x), vand(splat(-0.0), y)); }
+INLINE vmask mand(vmask a, vmask b) { return vand(a, b); }
+INLINE vmask mor(vmask a, vmask b) { return vor(a, b); }
+INLINE vreal pick(vmask m, vreal a, vreal b) { return vor(vand(m, a), vandnot(m, b)); }
+INLINE vreal neg(vreal x) { return vxor(x, splat(-0.0)); }   /* C's -x: flips the sign, also of 0 */
+INLINE vreal vabs(vreal x) { return vandnot(splat(-0.0), x); }
+INLINE vreal vcopysign(vreal x, vreal y) { return vor(vandnot(splat(-0.0), x), vand(splat(-0.0), y)); }
