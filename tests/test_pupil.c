@@ -188,16 +188,16 @@ static vec3 film_point(const camera *c, int i)
 static void trace_directions(const lens *l, vec3 p, const double *a, const double *b, int n,
                              bool *passed)
 {
-    for (int done = 0; done < n; done += TRACE_SOA_MAX) {
-        const int m = n - done < TRACE_SOA_MAX ? n - done : TRACE_SOA_MAX;
-        trace_soa s;
+    for (int done = 0; done < n; done += TRACE_BATCH_MAX) {
+        const int m = n - done < TRACE_BATCH_MAX ? n - done : TRACE_BATCH_MAX;
+        trace_batch s;
         for (int k = 0; k < m; k++) {
             const double q = a[done + k] * a[done + k] + b[done + k] * b[done + k];
             s.ox[k] = p.x; s.oy[k] = p.y; s.oz[k] = p.z;
             s.dx[k] = a[done + k]; s.dy[k] = b[done + k]; s.dz[k] = sqrt(fmax(0.0, 1.0 - q));
             s.status[k] = q < 1.0 ? TRACE_PASSED : TRACE_MISSED;
         }
-        trace_soa_toward_scene(l, &s, m);
+        trace_batch_toward_scene(l, &s, m);
         for (int k = 0; k < m; k++)
             passed[done + k] = s.status[k] == TRACE_PASSED;
     }
@@ -208,9 +208,9 @@ static void trace_directions(const lens *l, vec3 p, const double *a, const doubl
 static long count_cells(const lens *l, vec3 p, double x0, double y0, double h, int n, double *box)
 {
     long count = 0;
-    double a[TRACE_SOA_MAX * 8], b[TRACE_SOA_MAX * 8];
-    bool passed[TRACE_SOA_MAX * 8];
-    const int chunk = TRACE_SOA_MAX * 8;
+    double a[TRACE_BATCH_MAX * 8], b[TRACE_BATCH_MAX * 8];
+    bool passed[TRACE_BATCH_MAX * 8];
+    const int chunk = TRACE_BATCH_MAX * 8;
     for (long start = 0; start < (long)n * n; start += chunk) {
         const int m = (long)n * n - start < chunk ? (int)((long)n * n - start) : chunk;
         for (int k = 0; k < m; k++) {

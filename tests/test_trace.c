@@ -160,9 +160,9 @@ Test(trace, apertures_clip)
 /* Returns the rays that passed; *traced counts those traced. */
 static int check_batch(const lens *l, const char *name, int n, int *traced)
 {
-    trace_soa b;
-    ray single[TRACE_SOA_MAX];
-    bool blocked[TRACE_SOA_MAX];
+    trace_batch b;
+    ray single[TRACE_BATCH_MAX];
+    bool blocked[TRACE_BATCH_MAX];
     unsigned seed = 12345;
     for (int k = 0; k < n; k++) {
         seed = seed * 1103515245u + 12345u;
@@ -170,30 +170,30 @@ static int check_batch(const lens *l, const char *name, int n, int *traced)
         const vec3 o = v3(20 * fx, 15 * fy, 0);
         const vec3 target = v3(10 * fy, 10 * fx, l->surface[l->count - 1].vertex_z_mm);
         single[k] = (ray){o, v3_normalize(v3_sub(target, o))};
-        blocked[k] = k % 5 == 3 || (n == TRACE_SOA_MAX && k >= 32);
+        blocked[k] = k % 5 == 3 || (n == TRACE_BATCH_MAX && k >= 32);
         const ray r = blocked[k] ? (ray){v3(NAN, NAN, NAN), v3(NAN, NAN, NAN)} : single[k];
         b.ox[k] = r.o.x; b.oy[k] = r.o.y; b.oz[k] = r.o.z;
         b.dx[k] = r.d.x; b.dy[k] = r.d.y; b.dz[k] = r.d.z;
         b.status[k] = blocked[k] ? TRACE_MISSED : TRACE_PASSED;
     }
-    trace_soa_toward_scene(l, &b, n);
+    trace_batch_toward_scene(l, &b, n);
     int passed = 0;
     for (int k = 0; k < n; k++) {
         if (blocked[k]) {
             cr_assert_eq(b.status[k], TRACE_MISSED, "%s, %s n %d ray %d: came in blocked",
-                         trace_soa_isa(), name, n, k);
+                         trace_batch_isa(), name, n, k);
             continue;
         }
         (*traced)++;
         const trace_status st = trace_toward_scene(l, 0, l->count - 1, &single[k], NULL);
         cr_assert_eq(b.status[k], st, "%s, %s n %d ray %d: status %lld against %d",
-                     trace_soa_isa(), name, n, k, b.status[k], st);
+                     trace_batch_isa(), name, n, k, b.status[k], st);
         if (st != TRACE_PASSED) {
             /* Left on the last surface crossed by both (only passing rays are renormalized). */
             const double got_o[3] = {b.ox[k], b.oy[k], b.oz[k]};
             const double want_o[3] = {single[k].o.x, single[k].o.y, single[k].o.z};
             cr_assert(memcmp(got_o, want_o, sizeof got_o) == 0, "%s, %s n %d blocked ray %d differs",
-                      trace_soa_isa(), name, n, k);
+                      trace_batch_isa(), name, n, k);
             continue;
         }
         passed++;
@@ -201,7 +201,7 @@ static int check_batch(const lens *l, const char *name, int n, int *traced)
         const double want[6] = {single[k].o.x, single[k].o.y, single[k].o.z,
                                 single[k].d.x, single[k].d.y, single[k].d.z};
         cr_assert(memcmp(got, want, sizeof got) == 0, "%s, %s n %d ray %d differs",
-                  trace_soa_isa(), name, n, k);
+                  trace_batch_isa(), name, n, k);
     }
     return passed;
 }
@@ -210,7 +210,7 @@ static void check_batch_against_kernel(void)
 {
     const char *names[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm", "telephoto.250mm"};
     const double film[] = {36.77, 14.54, 23.192, 123.7439};
-    const int sizes[] = {1, 7, 31, 33, 61, TRACE_SOA_MAX};
+    const int sizes[] = {1, 7, 31, 33, 61, TRACE_BATCH_MAX};
     for (int li = 0; li < 4; li++) {
         char path[512];
         snprintf(path, sizeof path, LENS_DIR "%s.dat", names[li]);
@@ -230,16 +230,16 @@ static void check_batch_against_kernel(void)
 /* Each instruction set this processor has (the best is the default). */
 Test(trace, batch_and_single_ray_agree_bit_for_bit)
 {
-    const char *best = trace_soa_isa(), *isas[] = {"avx512", "avx2", "sse2", "scalar"};
+    const char *best = trace_batch_isa(), *isas[] = {"avx512", "avx2", "sse2", "scalar"};
     for (int i = 0; i < 4; i++) {
-        if (trace_soa_use_isa(isas[i]) != 0) {
+        if (trace_batch_use_isa(isas[i]) != 0) {
             cr_log_info("this processor has no %s: its lanes are not checked here", isas[i]);
             continue;
         }
-        cr_assert_str_eq(trace_soa_isa(), isas[i]);
+        cr_assert_str_eq(trace_batch_isa(), isas[i]);
         check_batch_against_kernel();
     }
-    cr_assert_eq(trace_soa_use_isa("scalar"), 0, "the one-ray kernel is always there");
-    cr_assert_eq(trace_soa_use_isa("avx1024"), -1, "an unknown name is refused");
-    cr_assert_eq(trace_soa_use_isa(best), 0);
+    cr_assert_eq(trace_batch_use_isa("scalar"), 0, "the one-ray kernel is always there");
+    cr_assert_eq(trace_batch_use_isa("avx1024"), -1, "an unknown name is refused");
+    cr_assert_eq(trace_batch_use_isa(best), 0);
 }

@@ -204,17 +204,17 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *lenses[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm", "telephoto.250mm"};
-    const char *best = trace_soa_isa();
+    const char *best = trace_batch_isa();
     const char *isas[] = {"avx512", "avx2", "sse2", "scalar"};
     printf("== full simulation by instruction set, one core (dgauss.50mm, stop-image pupil)\n");
     for (int i = 0; i < 4; i++)
-        if (trace_soa_use_isa(isas[i]) == 0) {
+        if (trace_batch_use_isa(isas[i]) == 0) {
             printf("%-7s ", isas[i]);
             char path[512];
             snprintf(path, sizeof path, "%s/dgauss.50mm.dat", argv[1]);
             bench_trace(path, PUPIL_STOP_IMAGE, TRACE_KIND_FULL);
         }
-    trace_soa_use_isa(best);
+    trace_batch_use_isa(best);
     printf("== tracing with %s, one core, 256x192 film, 16 spp, focus 10 m (median of 5)\n", best);
     for (int i = 0; i < 4; i++) {
         char path[512];

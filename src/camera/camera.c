@@ -273,7 +273,7 @@ static bool trace_thick(const camera *c, ray *r)
     return v3_isfinite(r->o);
 }
 
-static void soa_from_rays(trace_soa *b, const vec3 *origin, const vec3 *direction, int n)
+static void batch_from_rays(trace_batch *b, const vec3 *origin, const vec3 *direction, int n)
 {
     for (int k = 0; k < n; k++) {
         b->ox[k] = origin[k].x; b->oy[k] = origin[k].y; b->oz[k] = origin[k].z;
@@ -281,7 +281,7 @@ static void soa_from_rays(trace_soa *b, const vec3 *origin, const vec3 *directio
     }
 }
 
-static void rays_from_soa(ray *r, const trace_soa *b, int n)
+static void rays_from_batch(ray *r, const trace_batch *b, int n)
 {
     for (int k = 0; k < n; k++) {
         r[k].o = v3(b->ox[k], b->oy[k], b->oz[k]);
@@ -292,7 +292,7 @@ static void rays_from_soa(ray *r, const trace_soa *b, int n)
 void camera_trace_batch(const camera *c, sample_batch *s)
 {
     const int n = s->n;
-    trace_soa b;
+    trace_batch b;
     vec3 direction[CAMERA_BATCH];
     pupil_film_rays(&c->pupil, n, s->film_point, s->u, s->v, direction, s->weight);
     for (int k = 0; k < n; k++) {
@@ -308,9 +308,9 @@ void camera_trace_batch(const camera *c, sample_batch *s)
                 b.status[k] = TRACE_MISSED;
         }
     } else {
-        soa_from_rays(&b, s->film_point, direction, n);
-        trace_soa_toward_scene(&c->lens, &b, n);
-        rays_from_soa(s->out, &b, n);
+        batch_from_rays(&b, s->film_point, direction, n);
+        trace_batch_toward_scene(&c->lens, &b, n);
+        rays_from_batch(s->out, &b, n);
     }
     /* & rather than &&: whether a ray passed is unpredictable, a branch on it costly. */
     for (int k = 0; k < n; k++)

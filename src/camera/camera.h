@@ -64,7 +64,7 @@ bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out
 
 /* Film samples traced together, interleaved for speed: in, each one's film point and pupil
    sample; out, its ray, its weight and whether the lens passed it. */
-enum { CAMERA_BATCH = TRACE_SOA_MAX };   /* one call of the batch tracer */
+enum { CAMERA_BATCH = TRACE_BATCH_MAX };   /* one call of the batch tracer */
 typedef struct sample_batch {
     int n;                                  /* <= CAMERA_BATCH */
     vec3 film_point[CAMERA_BATCH];

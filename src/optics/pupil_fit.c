@@ -38,16 +38,16 @@ typedef struct region {
 static void trace_points(const pupil *pu, const lens *l, double r, const double *x,
                          const double *y, int n, bool *passed)
 {
-    for (int done = 0; done < n; done += TRACE_SOA_MAX) {
-        const int m = n - done < TRACE_SOA_MAX ? n - done : TRACE_SOA_MAX;
-        trace_soa b;
+    for (int done = 0; done < n; done += TRACE_BATCH_MAX) {
+        const int m = n - done < TRACE_BATCH_MAX ? n - done : TRACE_BATCH_MAX;
+        trace_batch b;
         for (int k = 0; k < m; k++) {
             const vec3 d = pupil_direction(pu, v3(r, 0, 0), x[done + k], y[done + k]);
             b.ox[k] = r; b.oy[k] = 0; b.oz[k] = 0;
             b.dx[k] = d.x; b.dy[k] = d.y; b.dz[k] = d.z;
             b.status[k] = v3_isfinite(d) ? TRACE_PASSED : TRACE_MISSED;
         }
-        trace_soa_toward_scene(l, &b, m);
+        trace_batch_toward_scene(l, &b, m);
         for (int k = 0; k < m; k++)
             passed[done + k] = b.status[k] == TRACE_PASSED;
     }
@@ -138,13 +138,13 @@ static bool find_on_axis(const pupil *pu, const lens *l, double r, double guess,
             return true;
         }
     const double half = search_half_side_mm(pu, l, r);
-    for (int done = 0; done < SCAN; done += TRACE_SOA_MAX) {
-        double sx[TRACE_SOA_MAX], sy[TRACE_SOA_MAX] = {0};
-        bool sp[TRACE_SOA_MAX];
-        for (int k = 0; k < TRACE_SOA_MAX; k++)
+    for (int done = 0; done < SCAN; done += TRACE_BATCH_MAX) {
+        double sx[TRACE_BATCH_MAX], sy[TRACE_BATCH_MAX] = {0};
+        bool sp[TRACE_BATCH_MAX];
+        for (int k = 0; k < TRACE_BATCH_MAX; k++)
             sx[k] = -half + 2.0 * half * (done + k + 0.5) / SCAN;
-        trace_points(pu, l, r, sx, sy, TRACE_SOA_MAX, sp);
-        for (int k = 0; k < TRACE_SOA_MAX; k++)
+        trace_points(pu, l, r, sx, sy, TRACE_BATCH_MAX, sp);
+        for (int k = 0; k < TRACE_BATCH_MAX; k++)
             if (sp[k]) {
                 *x = sx[k];
                 return true;

@@ -10,10 +10,10 @@
 typedef struct isa {
     const char *name;
     int lanes;                   /* 1: the one-ray kernel */
-    void (*trace)(const lens *l, trace_soa *b, int n);
+    void (*trace)(const lens *l, trace_batch *b, int n);
 } isa;
 
-static void trace_one_by_one(const lens *l, trace_soa *b, int n)
+static void trace_one_by_one(const lens *l, trace_batch *b, int n)
 {
     for (int k = 0; k < n; k++) {
         if (b->status[k] != TRACE_PASSED)
@@ -59,13 +59,13 @@ static void choose_best(void)
             in_use = &isas[i];
 }
 
-const char *trace_soa_isa(void)
+const char *trace_batch_isa(void)
 {
     pthread_once(&chosen, choose_best);
     return in_use->name;
 }
 
-int trace_soa_use_isa(const char *name)
+int trace_batch_use_isa(const char *name)
 {
     pthread_once(&chosen, choose_best);
     for (int i = 0; i < ISA_COUNT; i++)
@@ -76,7 +76,7 @@ int trace_soa_use_isa(const char *name)
     return -1;
 }
 
-void trace_soa_toward_scene(const lens *l, trace_soa *b, int n)
+void trace_batch_toward_scene(const lens *l, trace_batch *b, int n)
 {
     pthread_once(&chosen, choose_best);
     const isa *s = in_use;

@@ -6,25 +6,25 @@
 #include "optics/trace.h"
 
 /* A multiple of every lane count (trace_lanes_isa.h): a short batch is padded up to the next
-   multiple of the lane count in place, never past TRACE_SOA_MAX. */
-enum { TRACE_SOA_MAX = 64 };
+   multiple of the lane count in place, never past TRACE_BATCH_MAX. */
+enum { TRACE_BATCH_MAX = 64 };
 
-typedef struct trace_soa {
-    double ox[TRACE_SOA_MAX], oy[TRACE_SOA_MAX], oz[TRACE_SOA_MAX];
-    double dx[TRACE_SOA_MAX], dy[TRACE_SOA_MAX], dz[TRACE_SOA_MAX];
-    long long status[TRACE_SOA_MAX];   /* a trace_status; TRACE_PASSED on entry for the rays
+typedef struct trace_batch {
+    double ox[TRACE_BATCH_MAX], oy[TRACE_BATCH_MAX], oz[TRACE_BATCH_MAX];
+    double dx[TRACE_BATCH_MAX], dy[TRACE_BATCH_MAX], dz[TRACE_BATCH_MAX];
+    long long status[TRACE_BATCH_MAX];   /* a trace_status; TRACE_PASSED on entry for the rays
                                           to trace */
-} trace_soa;
+} trace_batch;
 
-/* Traces rays 0 .. n-1 (n <= TRACE_SOA_MAX) through the whole lens toward the scene, with the
+/* Traces rays 0 .. n-1 (n <= TRACE_BATCH_MAX) through the whole lens toward the scene, with the
    best instruction set this processor has. Unit directions out. */
-void trace_soa_toward_scene(const lens *l, trace_soa *b, int n);
+void trace_batch_toward_scene(const lens *l, trace_batch *b, int n);
 
 /* The instruction set in use ("avx512", "avx2", "sse2" or "scalar", the one-ray kernel). */
-const char *trace_soa_isa(void);
+const char *trace_batch_isa(void);
 
 /* Uses the named instruction set from now on (tests and benchmarks; call it before tracing
    starts). Returns -1, changing nothing, when the name is unknown or this processor lacks it. */
-int trace_soa_use_isa(const char *name);
+int trace_batch_use_isa(const char *name);
 
 #endif

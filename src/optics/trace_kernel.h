@@ -13,7 +13,7 @@
      real            the number type of one lane (double or long double), REAL_MAX its largest
      vreal, vmask    LANES reals and a mask of LANES lanes
      INLINE          the attributes of every function (always inlined; the instruction set)
-     add sub mul dvd vmax vsqrt splat   arithmetic as C's; vmax(a, b) is a > b ? a : b
+     add sub mul divide vmax vsqrt splat   arithmetic as C's; vmax(a, b) is a > b ? a : b
      lt le gt ge ne  ordered comparisons (ne unordered, as C's !=), giving a vmask
      mand mor        mask logic;  bits(vmask) -> unsigned, bit i = lane i;  mask_of(unsigned)
      pick(m, a, b)   a where m, else b;  vabs, vcopysign, neg (C's -x, also of 0)
@@ -59,7 +59,7 @@ INLINE vmask intersect(const lens_surface *s, const vreal o[3], const vreal d[3]
                                 gt(vabs(mul(c, pz0)), splat(TRACE_TRANSFER_RADII)));
     vreal t0 = zero, px = o[0], py = o[1], pz = pz0;
     if (bits(transfer)) {
-        t0 = pick(transfer, dvd(neg(pz0), d[2]), zero);
+        t0 = pick(transfer, divide(neg(pz0), d[2]), zero);
         px = add(px, mul(t0, d[0]));
         py = add(py, mul(t0, d[1]));
         pz = pick(transfer, zero, pz0);
@@ -70,7 +70,7 @@ INLINE vmask intersect(const lens_surface *s, const vreal o[3], const vreal d[3]
     const vreal q = neg(add(B, vcopysign(vsqrt(vmax(disc, zero)), B)));
     /* q = 0 only for a ray tangent to the surface or lying in the plane: a miss. The far root
        q / c is q R (R exact from the file; it saves a division). */
-    const vreal near = pick(ne(q, zero), dvd(C, q), splat(NAN));
+    const vreal near = pick(ne(q, zero), divide(C, q), splat(NAN));
     const vreal far = mul(q, splat(cs != 0 ? s->radius_mm : NAN));
     const vmask swap = lt(far, near);
     const vreal lo = pick(swap, far, near), hi = pick(swap, near, far);
@@ -166,7 +166,7 @@ INLINE unsigned cross(const lens_surface *s, real a2, real eta, vreal o[3], vrea
 /* d / sqrt(d.d), as d * (1 / sqrt(d.d)). */
 INLINE void renormalize(vreal d[3])
 {
-    const vreal inv = dvd(splat(1), vsqrt(dot(d[0], d[1], d[2], d[0], d[1], d[2])));
+    const vreal inv = divide(splat(1), vsqrt(dot(d[0], d[1], d[2], d[0], d[1], d[2])));
     d[0] = mul(d[0], inv);
     d[1] = mul(d[1], inv);
     d[2] = mul(d[2], inv);

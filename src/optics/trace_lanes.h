@@ -1,12 +1,12 @@
 /* The full simulation over lanes of rays side by side: trace_kernel.h over vector registers,
-   driven over a batch (trace_soa). One ray alone is a chain of divisions and square roots,
+   driven over a batch (trace_batch). One ray alone is a chain of divisions and square roots,
    each waiting on the one before; independent rays side by side keep the processor busy.
 
    The includer (one file per instruction set) defines trace_kernel.h's operations over
    LANES doubles, load and store of LANES doubles, and names the entry point with
    LANES_ENTRY. */
 
-_Static_assert(TRACE_SOA_MAX % LANES == 0, "a batch is whole steps");
+_Static_assert(TRACE_BATCH_MAX % LANES == 0, "a batch is whole steps");
 
 typedef double real;
 #define REAL_MAX DBL_MAX
@@ -14,9 +14,9 @@ typedef double real;
 
 /* Rays 0 .. n-1 of b, n a multiple of LANES, surfaces last .. first. The surface loop is the
    outer one: the steps of one surface are independent and the processor overlaps them. */
-LANES_ENTRY(const lens *l, trace_soa *b, int n)
+LANES_ENTRY(const lens *l, trace_batch *b, int n)
 {
-    unsigned alive[TRACE_SOA_MAX / LANES];
+    unsigned alive[TRACE_BATCH_MAX / LANES];
     for (int g = 0; g < n / LANES; g++) {
         alive[g] = 0;
         for (int i = 0; i < LANES; i++)

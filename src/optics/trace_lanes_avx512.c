@@ -27,7 +27,7 @@ typedef struct vmask { __mmask8 k[VECS]; } vmask;
 MAP2(add, vreal, vreal, r.p[i] = _mm512_add_pd(a.p[i], b.p[i]))
 MAP2(sub, vreal, vreal, r.p[i] = _mm512_sub_pd(a.p[i], b.p[i]))
 MAP2(mul, vreal, vreal, r.p[i] = _mm512_mul_pd(a.p[i], b.p[i]))
-MAP2(dvd, vreal, vreal, r.p[i] = _mm512_div_pd(a.p[i], b.p[i]))
+MAP2(divide, vreal, vreal, r.p[i] = _mm512_div_pd(a.p[i], b.p[i]))
 MAP2(vmax, vreal, vreal, r.p[i] = _mm512_max_pd(a.p[i], b.p[i]))
 MAP2(lt, vmask, vreal, r.k[i] = _mm512_cmp_pd_mask(a.p[i], b.p[i], _CMP_LT_OQ))
 MAP2(le, vmask, vreal, r.k[i] = _mm512_cmp_pd_mask(a.p[i], b.p[i], _CMP_LE_OQ))

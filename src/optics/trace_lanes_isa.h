@@ -6,8 +6,8 @@
 
 #include "optics/trace_batch.h"
 
-void trace_lanes_sse2(const lens *l, trace_soa *b, int n);     /* 8 lanes */
-void trace_lanes_avx2(const lens *l, trace_soa *b, int n);     /* 16 lanes */
-void trace_lanes_avx512(const lens *l, trace_soa *b, int n);   /* 32 lanes */
+void trace_lanes_sse2(const lens *l, trace_batch *b, int n);     /* 8 lanes */
+void trace_lanes_avx2(const lens *l, trace_batch *b, int n);     /* 16 lanes */
+void trace_lanes_avx512(const lens *l, trace_batch *b, int n);   /* 32 lanes */
 
 #endif

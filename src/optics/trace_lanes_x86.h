@@ -21,7 +21,7 @@ typedef vreal vmask;
 BINARY(add, R(add))
 BINARY(sub, R(sub))
 BINARY(mul, R(mul))
-BINARY(dvd, R(div))
+BINARY(divide, R(div))
 BINARY(vand, R(and))
 BINARY(vor, R(or))
 BINARY(vandnot, R(andnot))

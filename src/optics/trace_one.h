@@ -18,7 +18,7 @@ typedef bool vmask;
 INLINE vreal add(vreal a, vreal b) { return a + b; }
 INLINE vreal sub(vreal a, vreal b) { return a - b; }
 INLINE vreal mul(vreal a, vreal b) { return a * b; }
-INLINE vreal dvd(vreal a, vreal b) { return a / b; }
+INLINE vreal divide(vreal a, vreal b) { return a / b; }
 INLINE vreal vmax(vreal a, vreal b) { return a > b ? a : b; }
 INLINE vreal vsqrt(vreal a) { return sqrt(a); }
 INLINE vreal splat(real a) { return a; }
