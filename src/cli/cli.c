@@ -1,4 +1,5 @@
 #include "cli/cli.h"
+#include "cli/values.h"
 
 #include <errno.h>
 #include <math.h>
@@ -103,150 +104,30 @@ static const cli_option OPTIONS[] = {
      "  --seed N                      the sample pattern's seed [0]\n"},
 };
 
-static int bad(l2p_error *err, const char *opt, const char *want, const char *got)
-{
-    return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s: expected %s, got '%s'", opt, want, got);
-}
-
-/* A whole, finite number and nothing else. */
-static bool parse_double(const char *s, double *v)
-{
-    char *end;
-    errno = 0;
-    *v = strtod(s, &end);
-    return end != s && *end == '\0' && errno == 0 && isfinite(*v);
-}
-
-static bool parse_int(const char *s, int *v)
-{
-    char *end;
-    errno = 0;
-    long x = strtol(s, &end, 10);
-    if (end == s || *end != '\0' || errno || x < -2147483647L || x > 2147483647L)
-        return false;
-    *v = (int)x;
-    return true;
-}
-
-/* "x,y,z" or "<x,y,z>", as in POV-Ray. */
-static bool parse_vec3(const char *s, vec3 *v)
-{
-    char buf[256];
-    size_t n = strlen(s);
-    if (n >= sizeof buf || n == 0)
-        return false;
-    if (s[0] == '<' && s[n - 1] == '>') {
-        memcpy(buf, s + 1, n - 2);
-        buf[n - 2] = '\0';
-    } else {
-        memcpy(buf, s, n + 1);
-    }
-    double c[3];
-    char *part = buf;
-    for (int i = 0; i < 3; i++) {
-        char *comma = strchr(part, ',');
-        if ((i < 2) != (comma != NULL))
-            return false;
-        if (comma)
-            *comma = '\0';
-        while (*part == ' ')
-            part++;
-        if (!parse_double(part, &c[i]))
-            return false;
-        part = comma ? comma + 1 : part;
-    }
-    *v = v3(c[0], c[1], c[2]);
-    return true;
-}
-
-/* "X0,Y0,X1,Y1", four whole numbers (strtol, not sscanf's %d: out-of-range digits are
-   refused instead of being undefined behaviour). */
-static bool parse_crop(const char *s, camera_options *o)
-{
-    int v[4];
-    char buf[128];
-    if (strlen(s) >= sizeof buf)
-        return false;
-    memcpy(buf, s, strlen(s) + 1);
-    char *part = buf;
-    for (int i = 0; i < 4; i++) {
-        char *comma = strchr(part, ',');
-        if ((i < 3) != (comma != NULL))
-            return false;
-        if (comma)
-            *comma = '\0';
-        if (!parse_int(part, &v[i]))
-            return false;
-        part = comma ? comma + 1 : part;
-    }
-    o->crop_x0 = v[0];
-    o->crop_y0 = v[1];
-    o->crop_x1 = v[2];
-    o->crop_y1 = v[3];
-    return v[0] >= 0 && v[1] >= 0 && v[2] > v[0] && v[3] > v[1];
-}
-
-static int positive_int(const char *opt, const char *v, int *out, l2p_error *err)
-{
-    if (!parse_int(v, out) || *out <= 0)
-        return bad(err, opt, "a positive whole number", v);
-    return L2P_OK;
-}
-
-static int positive_double(const char *opt, const char *v, double *out, l2p_error *err)
-{
-    if (!parse_double(v, out) || !(*out > 0.0))
-        return bad(err, opt, "a positive number", v);
-    return L2P_OK;
-}
-
-/* A whole number in [1, most]. */
-static int int_up_to(const char *opt, const char *v, int most, int *out, l2p_error *err)
-{
-    if (!parse_int(v, out) || *out <= 0 || *out > most) {
-        char want[64];
-        snprintf(want, sizeof want, "a whole number from 1 to %d", most);
-        return bad(err, opt, want, v);
-    }
-    return L2P_OK;
-}
-
-/* A number in [least, most]. */
-static int double_in(const char *opt, const char *v, double least, double most, double *out,
-                     l2p_error *err)
-{
-    if (!parse_double(v, out) || !(*out >= least && *out <= most)) {
-        char want[96];
-        snprintf(want, sizeof want, "a number from %g to %g", least, most);
-        return bad(err, opt, want, v);
-    }
-    return L2P_OK;
-}
-
 static int film_option(cli *c, const char *opt, const char *v, l2p_error *err)
 {
     camera_options *o = &c->cam;
     if (!strcmp(opt, "--width"))
-        return positive_int(opt, v, &o->width, err);
+        return value_positive_int(opt, v, &o->width, err);
     if (!strcmp(opt, "--height"))
-        return positive_int(opt, v, &o->height, err);
+        return value_positive_int(opt, v, &o->height, err);
     if (!strcmp(opt, "--spp"))
-        return positive_int(opt, v, &o->spp, err);
+        return value_positive_int(opt, v, &o->spp, err);
     if (!strcmp(opt, "--film-diagonal")) {
         c->diagonal_given = true;
-        return positive_double(opt, v, &o->film_diagonal_mm, err);
+        return value_positive_double(opt, v, &o->film_diagonal_mm, err);
     }
     if (!strcmp(opt, "--angle")) {   /* the film width: framing.c */
         c->angle_scene = !strcmp(v, "scene");
         if (c->angle_scene)
             return L2P_OK;
-        if (!parse_double(v, &c->angle_deg) || !(c->angle_deg > 0.0 && c->angle_deg < 360.0))
-            return bad(err, opt, "degrees (more than 0, less than 360) or 'scene'", v);
+        if (!value_double(v, &c->angle_deg) || !(c->angle_deg > 0.0 && c->angle_deg < 360.0))
+            return value_bad(err, opt, "degrees (more than 0, less than 360) or 'scene'", v);
         return L2P_OK;
     }
     if (!strcmp(opt, "--film-distance")) {
-        if (!parse_double(v, &o->film_distance_mm) || o->film_distance_mm < 0.0)
-            return bad(err, opt, "a distance in mm, 0 or more", v);
+        if (!value_double(v, &o->film_distance_mm) || o->film_distance_mm < 0.0)
+            return value_bad(err, opt, "a distance in mm, 0 or more", v);
         return L2P_OK;
     }
     if (!strcmp(opt, "--focus-distance")) {
@@ -254,10 +135,18 @@ static int film_option(cli *c, const char *opt, const char *v, l2p_error *err)
             o->focus_distance_units = INFINITY;
             return L2P_OK;
         }
-        return positive_double(opt, v, &o->focus_distance_units, err);
+        return value_positive_double(opt, v, &o->focus_distance_units, err);
     }
-    if (!strcmp(opt, "--crop"))
-        return parse_crop(v, o) ? L2P_OK : bad(err, opt, "X0,Y0,X1,Y1 with X1 > X0 >= 0 and Y1 > Y0 >= 0", v);
+    if (!strcmp(opt, "--crop")) {
+        int crop[4];
+        if (!value_crop(v, crop))
+            return value_bad(err, opt, "X0,Y0,X1,Y1 with X1 > X0 >= 0 and Y1 > Y0 >= 0", v);
+        o->crop_x0 = crop[0];
+        o->crop_y0 = crop[1];
+        o->crop_x1 = crop[2];
+        o->crop_y1 = crop[3];
+        return L2P_OK;
+    }
     return -1;
 }
 
@@ -265,20 +154,20 @@ static int lens_option(cli *c, const char *opt, const char *v, l2p_error *err)
 {
     camera_options *o = &c->cam;
     if (!strcmp(opt, "--aperture-diameter"))
-        return positive_double(opt, v, &o->aperture_diameter_mm, err);
+        return value_positive_double(opt, v, &o->aperture_diameter_mm, err);
     if (!strcmp(opt, "--f-number"))
-        return positive_double(opt, v, &o->f_number, err);
+        return value_positive_double(opt, v, &o->f_number, err);
     if (!strcmp(opt, "--pupil"))
-        return pupil_kind_parse(v, &o->pupil) ? bad(err, opt, "stop, rear or stop-image", v) : 0;
+        return pupil_kind_parse(v, &o->pupil) ? value_bad(err, opt, "stop, rear or stop-image", v) : 0;
     if (!strcmp(opt, "--trace")) {
         if (strcmp(v, "full") && strcmp(v, "thick"))
-            return bad(err, opt, "full or thick", v);
+            return value_bad(err, opt, "full or thick", v);
         o->trace = strcmp(v, "thick") ? TRACE_KIND_FULL : TRACE_KIND_THICK;
         return L2P_OK;
     }
     if (!strcmp(opt, "--weighting")) {
         if (strcmp(v, "normalized") && strcmp(v, "physical"))
-            return bad(err, opt, "normalized or physical", v);
+            return value_bad(err, opt, "normalized or physical", v);
         o->weighting = strcmp(v, "physical") ? WEIGHTING_NORMALIZED : WEIGHTING_PHYSICAL;
         return L2P_OK;
     }
@@ -287,7 +176,7 @@ static int lens_option(cli *c, const char *opt, const char *v, l2p_error *err)
         errno = 0;
         unsigned long long s = strtoull(v, &end, 10);
         if (end == v || *end || errno || v[0] == '-')
-            return bad(err, opt, "a whole number, 0 or more", v);
+            return value_bad(err, opt, "a whole number, 0 or more", v);
         o->seed = s;
         return L2P_OK;
     }
@@ -299,16 +188,16 @@ static int place_option(cli *c, const char *opt, const char *v, l2p_error *err)
     camera_options *o = &c->cam;
     c->placed |= !strcmp(opt, "--location") || !strcmp(opt, "--look-at") || !strcmp(opt, "--sky");
     if (!strcmp(opt, "--location"))
-        return parse_vec3(v, &o->location) ? 0 : bad(err, opt, "x,y,z", v);
+        return value_vec3(v, &o->location) ? 0 : value_bad(err, opt, "x,y,z", v);
     if (!strcmp(opt, "--look-at"))
-        return parse_vec3(v, &o->look_at) ? 0 : bad(err, opt, "x,y,z", v);
+        return value_vec3(v, &o->look_at) ? 0 : value_bad(err, opt, "x,y,z", v);
     if (!strcmp(opt, "--sky"))
-        return parse_vec3(v, &o->sky) ? 0 : bad(err, opt, "x,y,z", v);
+        return value_vec3(v, &o->sky) ? 0 : value_bad(err, opt, "x,y,z", v);
     /* Millimetres in a scene unit: from a micrometre to a thousand kilometres. Beyond, the
        ray table's triangles (a lens aperture in scene units) leave float32, which is how
        POV-Ray stores mesh vertices: they overflow to infinity or collapse to a point. */
     if (!strcmp(opt, "--unit-mm"))
-        return double_in(opt, v, UNIT_MM_LEAST, UNIT_MM_MOST, &o->unit_mm, err);
+        return value_double_in(opt, v, UNIT_MM_LEAST, UNIT_MM_MOST, &o->unit_mm, err);
     return -1;
 }
 
@@ -323,15 +212,15 @@ static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
     else if (!strcmp(opt, "--scene"))
         c->scene = v;
     else if (!strcmp(opt, "--jobs"))   /* outfile.c stops at most 256 children on a signal */
-        return int_up_to(opt, v, JOBS_MOST, &c->jobs, err);
+        return value_int_up_to(opt, v, JOBS_MOST, &c->jobs, err);
     else if (!strcmp(opt, "--memory-mb"))  /* up to 1 PiB: render converts it to a face count */
-        return positive_double(opt, v, &c->memory_mb, err) ? L2P_BAD_INPUT
-               : c->memory_mb > MEMORY_MB_MOST ? bad(err, opt, "a positive number up to 1073741824", v)
+        return value_positive_double(opt, v, &c->memory_mb, err) ? L2P_BAD_INPUT
+               : c->memory_mb > MEMORY_MB_MOST ? value_bad(err, opt, "a positive number up to 1073741824", v)
                                                : L2P_OK;
     else
         return -1;
     if (!*v)
-        return bad(err, opt, "a file name", v);
+        return value_bad(err, opt, "a file name", v);
     return L2P_OK;
 }
 
