@@ -110,6 +110,14 @@ Test(scene_camera, transforms_and_the_last_camera)
                              "  rotate <0, 5, 0> translate Target }\n");
 }
 
+static int count_newlines(const char *s)
+{
+    int n = 0;
+    for (; *s; s++)
+        n += *s == '\n';
+    return n;
+}
+
 Test(scene_camera, orthographic_is_refused)
 {
     const char *dir = test_tmpdir();
@@ -124,6 +132,39 @@ Test(scene_camera, orthographic_is_refused)
               errtext ? errtext : "");
     struct stat sb;
     cr_expect(stat(out, &sb) != 0, "an output was written");
+    free(errtext);
+}
+
+/* A camera in a file the scene includes from its folder, nested two deep: the probe reads
+   only the scene's text, so it is refused naming the scene's #include line and the camera's
+   file and line; with explicit placement the scene renders. Comments and strings that look
+   like a camera or an #include do not count. */
+Test(scene_camera, a_camera_in_an_included_file_is_refused)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], outer[512], inner[512], out[512];
+    snprintf(scene, sizeof scene, "%s/inc.pov", dir);
+    snprintf(outer, sizeof outer, "%s/outer.inc", dir);
+    snprintf(inner, sizeof inner, "%s/inner.inc", dir);
+    snprintf(out, sizeof out, "%s/out.png", dir);
+    write_text(inner, "// camera { location 0 }\n\ncamera { location <0, 1, -4> look_at 0 }\n");
+    write_text(outer, "/* #include \"nothing.inc\" */\n#include \"inner.inc\"\n");
+    write_text(scene, MARKERS_HEAD "#include \"colors.inc\"\n#include \"outer.inc\"\n");
+    char *errtext = NULL;
+    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
+    cr_expect_eq(st, 2, "%s", errtext ? errtext : "");
+    char where[600], what[600];
+    const int scene_line = count_newlines(MARKERS_HEAD) + 2;   /* #include "outer.inc" */
+    snprintf(where, sizeof where, "lens2pov: %s:%d: ", scene, scene_line);
+    snprintf(what, sizeof what, "%s (line 3)", inner);
+    cr_expect(errtext && !strncmp(errtext, where, strlen(where)) && strstr(errtext, what),
+              "expected '%s' and '%s' in: %s", where, what, errtext ? errtext : "");
+    free(errtext);
+    struct stat sb;
+    cr_expect(stat(out, &sb) != 0, "an output was written");
+    st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "--location", "0,1,-4",
+             "--look-at", "0,0,0", "-q", "-o", out);
+    cr_expect_eq(st, 0, "%s", errtext ? errtext : "");
     free(errtext);
 }
 

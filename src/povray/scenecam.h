@@ -37,4 +37,18 @@ char *scene_camera_rewrite(const char *text, size_t n);
 int scene_camera_from_log(const char *log, size_t n, const char *scene, scene_camera *out,
                           l2p_error *err);
 
+/* Calls visit with the name and line of every `#include "NAME"` of text (not in comments),
+   in order, until it returns false. */
+typedef bool (*scene_include_visit)(const char *name, size_t len, int line, void *ctx);
+void scene_text_includes(const char *text, size_t n, scene_include_visit visit, void *ctx);
+
+/* Whether text has a camera statement scene_camera_rewrite would replace; *line gets the
+   first one's line. */
+bool scene_text_has_camera(const char *text, size_t n, int *line);
+
+/* L2P_BAD_INPUT, naming the scene's #include line and the camera's file and line, when a file
+   the scene includes from its own folder (as POV-Ray finds it, run there) has a camera
+   statement: the probe rewrites only the scene's own text, so that camera would be missed. */
+int scene_camera_check_includes(const char *scene_path, l2p_error *err);
+
 #endif

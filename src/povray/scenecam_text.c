@@ -326,3 +326,40 @@ char *scene_camera_rewrite(const char *s, size_t n)
     }
     return t.s;
 }
+
+void scene_text_includes(const char *s, size_t n, scene_include_visit visit, void *ctx)
+{
+    size_t i = 0, prev_a = 0, prev_b = 0, prev2_a = 0, prev2_b = 0;
+    int line = 1;
+    while (i < n) {
+        const size_t j = skip_blank(s, n, i);
+        line += count_lines(s, i, j);
+        if ((i = j) >= n)
+            break;
+        const size_t e = token_end(s, n, i);
+        /* '#' 'include' "NAME": the name without its quotes (no escapes in a file name). */
+        if (s[i] == '"' && e - i >= 2 && s[e - 1] == '"' && is_word(s, prev_a, prev_b, "include") &&
+            prev2_b == prev2_a + 1 && s[prev2_a] == '#' &&
+            !visit(s + i + 1, e - i - 2, line, ctx))
+            return;
+        line += count_lines(s, i, e);
+        prev2_a = prev_a, prev2_b = prev_b;
+        prev_a = i, prev_b = e;
+        i = e;
+    }
+}
+
+bool scene_text_has_camera(const char *s, size_t n, int *line)
+{
+    char *copy = scene_camera_rewrite(s, n);
+    if (!copy)
+        return false;
+    const size_t m = strlen(copy);
+    size_t k = 0;
+    while (k < n && k < m && copy[k] == s[k])
+        k++;
+    const bool changed = k < n || m != n;
+    *line = changed ? count_lines(s, 0, k) + 1 : 0;
+    free(copy);
+    return changed;
+}
