@@ -174,6 +174,27 @@ int run_lens2pov(char **out, char **errout, ...)
     return run_lens2pov_argv(out, errout, args);
 }
 
+void run_lens2pov_ok(const char *what, ...)
+{
+    char *args[64];
+    int n = 0;
+    va_list ap;
+    va_start(ap, what);
+    for (char *a; (a = va_arg(ap, char *)) != NULL;) {
+        cr_assert_lt(n, 63, "too many arguments");
+        args[n++] = a;
+    }
+    va_end(ap);
+    args[n] = NULL;
+    char *errtext = NULL;
+    const int st = run_lens2pov_argv(NULL, &errtext, args);
+    /* A copy on the stack: the failed assertion ends the test before a free. */
+    char text[2048];
+    snprintf(text, sizeof text, "%s", errtext ? errtext : "");
+    free(errtext);
+    cr_assert_eq(st, 0, "%s: exit %d: %s", what, st, text);
+}
+
 int run_lens2pov_argv(char **out, char **errout, char *const args[])
 {
     const char *bin = getenv("LENS2POV");

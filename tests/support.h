@@ -16,6 +16,8 @@
    list; stdout and stderr go to files that *out and *errout receive (malloc'd, may be NULL).
    Returns the exit status. */
 int run_lens2pov(char **out, char **errout, ...);
+/* Runs it and fails the test, naming `what` and with its messages, unless it exits 0. */
+void run_lens2pov_ok(const char *what, ...);
 /* The same with the arguments in a NULL-terminated array. */
 int run_lens2pov_argv(char **out, char **errout, char *const args[]);
 

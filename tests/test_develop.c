@@ -145,7 +145,8 @@ Test(samplemap, chunk_count_and_rows)
 
 /* ---- developing ---- */
 
-Test(develop, every_pixel_exact)
+/* The three synthetic renders developed through the synthetic map into rgb. */
+static void develop_synthetic(float *rgb)
 {
     samplemap m;
     make_map(&m);
@@ -157,13 +158,19 @@ Test(develop, every_pixel_exact)
         cr_assert_eq(develop_accumulate(&m, k, px, w, h, sums, &err), L2P_OK, "%s", err.text);
         free(px);
     }
+    develop_finish(&m, sums, rgb);
+    free(sums);
+    samplemap_free(&m);
+}
+
+Test(develop, every_pixel_exact)
+{
     float got[3 * CW * CH], want[3 * CW * CH];
-    develop_finish(&m, sums, got);
+    develop_synthetic(got);
     expected_picture(want);
     for (int i = 0; i < 3 * CW * CH; i++)
         cr_assert_eq(got[i], want[i], "value %d: %.9g != %.9g", i, got[i], want[i]);
-    free(sums);
-    samplemap_free(&m);
+
 }
 
 /* Two literal pixels, worked by hand: crop pixel (0, 0) (film 2,1) gets faces 0 (w 0.25,
@@ -171,26 +178,14 @@ Test(develop, every_pixel_exact)
    gets face 5 (w 0.5, colour 5.5,10,95) and face 17 (w 0.5, colour 17.5,34,83). */
 Test(develop, hand_computed_pixels)
 {
-    samplemap m;
-    make_map(&m);
-    double *sums = calloc(3 * CW * CH, sizeof *sums);
-    l2p_error err = {0, ""};
-    for (int k = 0; k < 3; k++) {
-        int w, h;
-        float *px = make_render(k, &w, &h);
-        cr_assert_eq(develop_accumulate(&m, k, px, w, h, sums, &err), L2P_OK, "%s", err.text);
-        free(px);
-    }
     float rgb[3 * CW * CH];
-    develop_finish(&m, sums, rgb);
+    develop_synthetic(rgb);
     cr_assert_eq(rgb[0], (0.25f * 0.5f + 0.25f * 12.5f) / 2);
     cr_assert_eq(rgb[1], (0.25f * 24.0f) / 2);
     cr_assert_eq(rgb[2], (0.25f * 100.0f + 0.25f * 88.0f) / 2);
     cr_assert_eq(rgb[3], (0.5f * 5.5f + 0.5f * 17.5f) / 2);
     cr_assert_eq(rgb[4], (0.5f * 10.0f + 0.5f * 34.0f) / 2);
     cr_assert_eq(rgb[5], (0.5f * 95.0f + 0.5f * 83.0f) / 2);
-    free(sums);
-    samplemap_free(&m);
 }
 
 Test(develop, wrong_render_size_refused)

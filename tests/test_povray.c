@@ -95,6 +95,14 @@ static povray_options options(const char *scene, const char *work_dir, int jobs)
     return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL};
 }
 
+/* The one-chunk table of make_chunks rendered from dir with scene, one job. */
+static int render_one_chunk(fixture *fx, const char *dir, const char *scene, l2p_error *err)
+{
+    make_chunks(fx, dir, 1, (const int[]){1});
+    povray_options o = options(scene, dir, 1);
+    return povray_render_chunks(fx->chunk, 1, &o, err);
+}
+
 /* ---------------------------------------------------------------- reading the EXR back */
 
 /* The 4x3 pixels' RGB, read with oiiotool (the tests link no C++). */
@@ -143,10 +151,8 @@ Test(povray, renders_a_modern_scene_through_the_lens_camera)
     char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
     write_text(scene, MODERN_SCENE);
     fixture fx;
-    make_chunks(&fx, dir, 1, (const int[]){1});
-    povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_OK, "%s", err.text);
     expect_uniform(fx.chunk[0].output_exr, 0.25f, 0.5f, 0.75f);
     free_fixture(&fx);
     free(scene);
@@ -163,10 +169,8 @@ Test(povray, an_old_scene_keeps_its_gamma_and_povray_ini_cannot_change_it)
     write_text(scene, "background { rgb 0.25 }\n");
     write_text(ini, "Display_Gamma=1.0\nOutput_Alpha=On\nAntialias=On\n");
     fixture fx;
-    make_chunks(&fx, dir, 1, (const int[]){1});
-    povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_OK, "%s", err.text);
     const float v = powf((0.25f + 0.055f) / 1.055f, 2.4f);
     expect_uniform(fx.chunk[0].output_exr, v, v, v);
     free_fixture(&fx);
@@ -186,10 +190,8 @@ Test(povray, includes_resolve_from_the_scene_folder_and_the_library)
     write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n#include \"colors.inc\"\n"
                     "#include \"mine.inc\"\nbackground { MyColour }\n");
     fixture fx;
-    make_chunks(&fx, dir, 1, (const int[]){1});
-    povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_OK, "%s", err.text);
     expect_uniform(fx.chunk[0].output_exr, 0.5f, 0.25f, 0.0f);
     free_fixture(&fx);
     free(scene);
@@ -209,13 +211,12 @@ Test(povray, scene_paths_that_are_not_ascii_work_and_errors_name_them)
     write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
                     "#include \"mine.inc\"\nbackground { MyColour }\n");
     fixture fx;
-    make_chunks(&fx, dir, 1, (const int[]){1});
-    povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_OK, "%s", err.text);
     expect_uniform(fx.chunk[0].output_exr, 0.5f, 0.5f, 0.5f);
 
     write_text(mine, "#declare MyColour = rgb 0.5;\nsphere { 0, 1 pigment { foo } }\n");
+    povray_options o = options(scene, dir, 1);
     cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
     char *expected = fmt("%s:%s: ", mine, "2");
     cr_expect(strncmp(err.text, expected, strlen(expected)) == 0, "%s", err.text);
@@ -235,10 +236,8 @@ Test(povray, a_syntax_error_names_the_file_and_line)
     write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
                     "sphere { <0,0,0>, 1 pigment { rgb 1 }\nbox { 0, 1 }\n");
     fixture fx;
-    make_chunks(&fx, dir, 1, (const int[]){1});
-    povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_FAILED);
     cr_assert_eq(err.status, L2P_FAILED);
     char *expected = fmt("%s:4: No matching } in 'sphere', box found instead%s", scene, "");
     cr_expect_str_eq(err.text, expected);
@@ -255,10 +254,8 @@ Test(povray, a_missing_image_file_is_named)
     write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n\n"
                     "plane { z, 1 pigment { image_map { png \"nofile.png\" } } }\n");
     fixture fx;
-    make_chunks(&fx, dir, 1, (const int[]){1});
-    povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_FAILED);
     char *expected = fmt("%s:4: %s", scene, "Cannot find file 'nofile.png'");
     cr_expect(strncmp(err.text, expected, strlen(expected)) == 0, "%s", err.text);
     free(expected);
@@ -272,10 +269,8 @@ Test(povray, a_missing_scene_is_bad_input)
 {
     char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "none.pov");
     fixture fx;
-    make_chunks(&fx, dir, 1, (const int[]){1});
-    povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_BAD_INPUT);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_BAD_INPUT);
     cr_expect(strstr(err.text, scene) && strstr(err.text, "No such file"), "%s", err.text);
     cr_expect(access(fx.chunk[0].output_exr, F_OK) != 0);
     free_fixture(&fx);

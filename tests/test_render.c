@@ -121,12 +121,9 @@ Test(render, picture_is_upright_and_unmirrored)
                "sphere { < 0.6,  0.4, 0>, 0.12 pigment { rgb <1, 0, 0> } finish { Glow } }\n"
                "sphere { <-0.6, -0.4, 0>, 0.12 pigment { rgb <0, 1, 0> } finish { Glow } }\n"
                "sphere { < 0,    0,   0>, 0.12 pigment { rgb <0, 0, 1> } finish { Glow } }\n");
-    char *errtext;
-    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "64", "--height", "48",
+    run_lens2pov_ok("render", "render", scene, DGAUSS, "--width", "64", "--height", "48",
                  "--spp", "8", "--f-number", "8", "--location", "0,0,-4", "--look-at", "0,0,0",
-                 "--quiet", "-o", out);
-    cr_assert_eq(st, 0, "render: %s", errtext);
-    free(errtext);
+                 "--quiet", "-o", out, NULL);
     image im = load(out);
     cr_assert_eq(im.w, 64);
     cr_assert_eq(im.h, 48);
@@ -509,17 +506,12 @@ Test(render, crop_is_a_region_of_the_whole_picture)
     PATH(crop, dir, "crop.exr");
     PATH(csv, dir, "crop.csv");
     write_text(scene, SMOOTH_SCENE);
-    char *errtext;
-    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "64", "--height", "48",
-                 "--spp", "4", "--f-number", "8", PLACE, "--seed", "3", "--quiet", "-o", full);
-    cr_assert_eq(st, 0, "full: %s", errtext);
-    free(errtext);
+    run_lens2pov_ok("full", "render", scene, DGAUSS, "--width", "64", "--height", "48",
+                 "--spp", "4", "--f-number", "8", PLACE, "--seed", "3", "--quiet", "-o", full, NULL);
     const int x0 = 7, y0 = 5, x1 = 40, y1 = 29;
-    st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "64", "--height", "48", "--spp",
+    run_lens2pov_ok("crop", "render", scene, DGAUSS, "--width", "64", "--height", "48", "--spp",
              "4", "--f-number", "8", PLACE, "--seed", "3", "--crop", "7,5,40,29", "--rays", csv,
-             "--quiet", "-o", crop);
-    cr_assert_eq(st, 0, "crop: %s", errtext);
-    free(errtext);
+             "--quiet", "-o", crop, NULL);
     /* Only the region's rays went to POV-Ray: at most 4 a pixel (the lens blocks a few toward
        the crop's outer corner even at f/8), all inside it. */
     size_t n;
@@ -569,17 +561,12 @@ Test(render, chunks_and_jobs_do_not_change_the_picture)
     PATH(many, dir, "many.exr");
     PATH(keep, dir, "work");
     write_text(scene, SMOOTH_SCENE);
-    char *errtext;
-    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "32", "--height", "24",
+    run_lens2pov_ok("--jobs 1", "render", scene, DGAUSS, "--width", "32", "--height", "24",
                  "--spp", "6", "--f-number", "8", PLACE, "--seed", "9", "--jobs", "1", "--quiet",
-                 "-o", one);
-    cr_assert_eq(st, 0, "--jobs 1: %s", errtext);
-    free(errtext);
-    st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "32", "--height", "24", "--spp",
+                 "-o", one, NULL);
+    run_lens2pov_ok("--jobs 2 --memory-mb 0.05", "render", scene, DGAUSS, "--width", "32", "--height", "24", "--spp",
              "6", "--f-number", "8", PLACE, "--seed", "9", "--jobs", "2", "--memory-mb", "0.05",
-             "--keep-temp", keep, "--quiet", "-o", many);
-    cr_assert_eq(st, 0, "--jobs 2 --memory-mb 0.05: %s", errtext);
-    free(errtext);
+             "--keep-temp", keep, "--quiet", "-o", many, NULL);
     const int chunks = count_entries(keep, "rays.c", NULL, 0) / 3;   /* .inc .ini .exr */
     cr_expect_geq(chunks, 5, "only %d chunks", chunks);
     image a = load(one), b = load(many);
@@ -606,12 +593,9 @@ Test(render, povray_starts_on_a_chunk_while_the_rest_are_written)
     PATH(csv, dir, "rays.csv");
     PATH(keep, dir, "work");
     write_text(scene, MODERN "background { rgb 0.5 }\n");
-    char *errtext;
-    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "128", "--height", "96",
+    run_lens2pov_ok("render", "render", scene, DGAUSS, "--width", "128", "--height", "96",
                  "--spp", "16", PLACE, "--jobs", "2", "--rays", csv,
-                 "--keep-temp", keep, "--quiet", "-o", out);
-    cr_assert_eq(st, 0, "%s", errtext);
-    free(errtext);
+                 "--keep-temp", keep, "--quiet", "-o", out, NULL);
     const int chunks = count_entries(keep, "rays.c", NULL, 0) / 3;   /* .inc .ini .exr */
     cr_assert_eq(chunks, 2, "%d chunks", chunks);
     char first[600], last[600];
@@ -668,12 +652,9 @@ static void expect_same_as_povray(const char *header, double expected_code)
              "plane { z, 0 pigment { rgb <0.3, 0.5, 0.1> } finish { ambient 1 diffuse 0 } }\n",
              header);
     write_text(scene, text);
-    char *errtext;
-    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "64",
+    run_lens2pov_ok("render", "render", scene, DGAUSS, "--width", "64",
                  "--height", "48", "--spp", "4", "--f-number", "8", PLACE, "--quiet", "-o",
-                 lens_png);
-    cr_assert_eq(st, 0, "render: %s", errtext);
-    free(errtext);
+                 lens_png, NULL);
     run_povray(dir, "flat.pov", "own.png", 64, 48, "+FN");
     image lens = load(lens_png), own = load(own_png);
     cr_assert(lens.w == 64 && lens.h == 48 && own.w == 64 && own.h == 48);
@@ -749,21 +730,16 @@ Test(render, chunks_share_the_faces_equally_between_jobs)
     snprintf(csv, sizeof csv, "%s/rays.csv", dir);
     snprintf(prefix, sizeof prefix, "%s/rays", dir);
     write_text(scene, TINY_SCENE);
-    char *errtext = NULL;
     /* The rear pupil, so that rows differ much in the rays they pass. */
     const char *camera[] = {"--width", "96", "--height", "64", "--spp", "4", "--look-at", "0,0,3",
                             "--pupil", "rear"};
-    int st = run_lens2pov(NULL, &errtext, "render", scene, LENS_DIR "wide.22mm.dat", camera[0],
+    run_lens2pov_ok("render", "render", scene, LENS_DIR "wide.22mm.dat", camera[0],
                           camera[1], camera[2], camera[3], camera[4], camera[5], camera[6],
                           camera[7], camera[8], camera[9], "--jobs", "2", "--keep-temp", keep,
                           "-o", image, "--quiet", NULL);
-    cr_assert_eq(st, 0, "%s", errtext);
-    free(errtext);
-    st = run_lens2pov(NULL, &errtext, "trace", LENS_DIR "wide.22mm.dat", camera[0], camera[1],
+    run_lens2pov_ok("trace", "trace", LENS_DIR "wide.22mm.dat", camera[0], camera[1],
                       camera[2], camera[3], camera[4], camera[5], camera[6], camera[7], camera[8],
                       camera[9], "--rays", csv, "-o", prefix, "--quiet", NULL);
-    cr_assert_eq(st, 0, "%s", errtext);
-    free(errtext);
     size_t passed;
     free(read_rays_csv(csv, &passed));
     cr_assert_eq(count_entries(keep, "rays.c", NULL, 0) / 3, 2, "one chunk per job (.inc, .ini, .exr each)");
