@@ -317,6 +317,11 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
     c->angle_deg = NAN;
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
+        if (!strcmp(a, "--")) {   /* the rest is POV-Ray's (render checks it) */
+            c->povray_args = argv + i + 1;
+            c->povray_arg_count = argc - i - 1;
+            break;
+        }
         if (is_flag(c, a))
             continue;
         if (a[0] != '-' || a[1] == '\0') {

@@ -19,6 +19,7 @@ static const char usage[] =
     "  lens2pov trace LENS [camera options] -o PREFIX [--rays FILE.csv] [--memory-mb MB]\n"
     "  lens2pov develop PREFIX [RENDER.exr ...] -o IMAGE   (.png, .exr or .tif)\n"
     "  lens2pov render SCENE.pov LENS [camera options] -o IMAGE [--jobs N] [--keep-temp DIR]\n"
+    "                  [-- POV-Ray options: +KFI1 +KFF10, Declare=N=V, +L, FILE.ini, ...]\n"
     "  lens2pov COMMAND --help      (its options and their defaults)\n"
     "  lens2pov --version\n"
     "See README.md and docs/ for the conventions.\n";
@@ -63,14 +64,17 @@ static const struct {
                 "Weights and averages POV-Ray's renders of PREFIX's ray table into IMAGE\n"
                 "(.png, .exr or .tif) [RENDER.exr: the names PREFIX's .ini files give].\n"
                 "  -o, --output IMAGE            (required)\n", false},
-    {"render", "usage: lens2pov render SCENE.pov LENS [camera options] -o IMAGE\n"
+    {"render", "usage: lens2pov render SCENE.pov LENS [camera options] -o IMAGE [-- POV-Ray options]\n"
                "trace, POV-Ray and develop in one, POV-Ray in parallel chunks.\n"
                "  -o, --output IMAGE            .png, .exr or .tif (required)\n"
                "  --jobs N                      POV-Ray processes at once [the cores]\n"
                "  --memory-mb MB                POV-Ray memory a process [1024]\n"
                "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"
                "  --keep-temp DIR               keep the ray tables, renders and logs [removed]\n"
-               "  -q, --quiet                   no progress on stderr\n", true},
+               "  -q, --quiet                   no progress on stderr\n"
+               "  -- OPTIONS                    POV-Ray's own, for every run: animation (+KFI, +KFF,\n"
+               "                                +KI, +KF, +KC, +K), Declare=, +L, +Q, FILE.ini;\n"
+               "                                an animation gives IMAGE01.png, IMAGE02.png, ...\n", true},
 };
 
 /* lens2pov COMMAND ... --help (or -h anywhere after the command): true when printed. */
@@ -171,7 +175,7 @@ static int cmd_trace(const cli *given, l2p_error *err)
     raytable_stats stats;
     /* One include unless --memory-mb asks for chunks that fit a POV-Ray process each. */
     const long long chunk_faces = c->memory_mb > 0 ? raytable_faces_for_memory(c->memory_mb) : 0;
-    const raytable_request q = {c->output, c->rays_csv, chunk_faces, !c->quiet, NULL};
+    const raytable_request q = {c->output, c->rays_csv, chunk_faces, !c->quiet, NULL, NULL};
     st = raytable_write(&cam, &q, &stats, err);
     if (!st && !c->quiet)
         fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%), %.2f s\n",
@@ -256,6 +260,10 @@ int main(int argc, char **argv)
     if (st)
         return fail(&err);
     const char *cmd = argv[1];
+    if (c.povray_args && strcmp(cmd, "render")) {
+        l2p_fail(&err, L2P_BAD_INPUT, NULL, 0, "options after -- are POV-Ray's: only render takes them");
+        return fail(&err);
+    }
     if (!strcmp(cmd, "info"))
         st = cmd_info(&c, &err);
     else if (!strcmp(cmd, "trace"))
