@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 #include "image/image_io.h"
 #include "povray/povargs.h"
 #include "povray/scenecam.h"
@@ -239,4 +240,34 @@ Test(animation, changing_focus_traces_again)
     cr_expect_eq(count_entries(keep, "rays.map", NULL, 0), 1);
     cr_expect_eq(count_entries(keep, "rays.t1.map", NULL, 0), 1);
     cr_expect(file_exists(tmp_path(dir, "f1.png")) && file_exists(tmp_path(dir, "f2.png")));
+}
+
+/* An .ini (with the animation in it) and +L given relative to the current folder, while
+   POV-Ray runs in the scene's. */
+Test(animation, ini_and_library_path_relative_to_here)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512], sub[512], cwd[512], exe[1024];
+    const char *scene = hold(scene_buf, dir, "scene.pov");
+    hold(sub, dir, "sub");
+    cr_assert_eq(mkdir(sub, 0777), 0);
+    write_text(tmp_path(sub, "a.ini"), "Initial_Frame=1\nFinal_Frame=2\n");
+    write_text(tmp_path(sub, "lib.inc"), "#declare Shade = 0.5;\n");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n#include \"lib.inc\"\n"
+                      "camera { location <clock, 1, -4> look_at <clock, 1, 0> }\n"
+                      "background { rgb Shade }\n");
+    /* Each test runs in a process of its own: the folder can change. */
+    cr_assert_not_null(getcwd(cwd, sizeof cwd));
+    const char *given = getenv("LENS2POV");
+    snprintf(exe, sizeof exe, "%s", given && *given ? given : "build/lens2pov");
+    if (exe[0] != '/')
+        snprintf(exe, sizeof exe, "%s/%s", cwd, given && *given ? given : "build/lens2pov");
+    setenv("LENS2POV", exe, 1);
+    cr_assert_eq(chdir(sub), 0);
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q",
+                       "-o", tmp_path(dir, "r.png"), "--", "a.ini", "+L.");
+    cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+    free(errtext);
+    cr_expect(file_exists(tmp_path(dir, "r1.png")) && file_exists(tmp_path(dir, "r2.png")));
 }

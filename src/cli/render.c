@@ -393,14 +393,22 @@ static int check_frame_outputs(const render_frames *rf, l2p_error *err)
     return st;
 }
 
-int render_command(const cli *c, l2p_error *err)
+int render_command(const cli *given, l2p_error *err)
 {
-    int st = check_inputs(c, err);
+    int st = check_inputs(given, err);
     if (st)
         return st;
+    cli resolved = *given;   /* POV-Ray's options with paths that hold in the scene's folder */
+    const cli *c = &resolved;
+    char **args = given->povray_args ? povargs_resolve(given->povray_args,
+                                                       given->povray_arg_count) : NULL;
+    if (given->povray_args && !args)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    resolved.povray_args = args;
     render_frames rf;
     if ((st = render_frames_plan(c, &rf, err)) || (st = check_frame_outputs(&rf, err))) {
         render_frames_free(&rf);
+        povargs_free(args);
         return st;
     }
     pthread_t loader;
@@ -417,5 +425,6 @@ int render_command(const cli *c, l2p_error *err)
     }
     outfile_discard(&csv);   /* nothing when committed */
     render_frames_free(&rf);
+    povargs_free(args);
     return st;
 }

@@ -1,10 +1,12 @@
 #include "povray/povargs.h"
 
 #include <ctype.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 /* Switches (+X or -X, case-insensitive) lens2pov sets for the ray table: the image's size
    (W, H: but WT, threads, and WL, warnings, are harmless), antialiasing (A...), output type
@@ -61,6 +63,50 @@ int povargs_check(char *const *args, int count, l2p_error *err)
                             "--width, --height, --spp, --crop and -o)", a, what);
     }
     return L2P_OK;
+}
+
+/* head + path, the path made absolute when it is relative and exists here. */
+static char *resolved(const char *head, size_t head_len, const char *path)
+{
+    char cwd[4096];
+    const bool relative = path[0] && path[0] != '/' && access(path, F_OK) == 0 &&
+                          getcwd(cwd, sizeof cwd);
+    const size_t n = head_len + strlen(path) + (relative ? strlen(cwd) + 2 : 1);
+    char *s = malloc(n);
+    if (s)
+        snprintf(s, n, "%.*s%s%s%s", (int)head_len, head, relative ? cwd : "",
+                 relative ? "/" : "", path);
+    return s;
+}
+
+static char *resolve_one(const char *a)
+{
+    if ((a[0] == '+' || a[0] == '-') && (a[1] == 'L' || a[1] == 'l'))
+        return resolved(a, 2, a + 2);
+    const char *eq = strchr(a, '=');
+    if (eq && (size_t)(eq - a) == strlen("Library_Path") && !strncasecmp(a, "Library_Path", 12))
+        return resolved(a, (size_t)(eq - a) + 1, eq + 1);
+    if (!eq && a[0] != '+' && a[0] != '-')
+        return resolved("", 0, a);
+    return strdup(a);
+}
+
+char **povargs_resolve(char *const *args, int count)
+{
+    char **out = calloc((size_t)count + 1, sizeof *out);
+    for (int i = 0; out && i < count; i++)
+        if (!(out[i] = resolve_one(args[i]))) {
+            povargs_free(out);
+            return NULL;
+        }
+    return out;
+}
+
+void povargs_free(char **args)
+{
+    for (int i = 0; args && args[i]; i++)
+        free(args[i]);
+    free(args);
 }
 
 int povargs_frame_digits(int final_frame)

@@ -11,6 +11,12 @@
    table. Values are not checked here: POV-Ray checks them on its first run. */
 int povargs_check(char *const *args, int count, l2p_error *err);
 
+/* The options with relative paths made absolute from the current folder: POV-Ray runs in the
+   scene's folder. Library paths (+L, Library_Path=) and file names (an .ini, given alone)
+   that exist here. NULL-terminated, malloc'd (povargs_free); NULL out of memory. */
+char **povargs_resolve(char *const *args, int count);
+void povargs_free(char **args);
+
 /* The digits POV-Ray pads a frame number to: those of the final frame. */
 int povargs_frame_digits(int final_frame);
 
