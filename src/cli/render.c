@@ -384,11 +384,12 @@ static int render_table(const render_frames *rf, int t, const workspace *ws, int
     return st;
 }
 
-/* Every frame's picture can be written: checked before any work. */
-static int check_frame_outputs(const render_frames *rf, l2p_error *err)
+/* Every frame's picture can be written: checked before any work (without POV-Ray's options
+   the one picture was checked with the other inputs). */
+static int check_frame_outputs(const cli *c, const render_frames *rf, l2p_error *err)
 {
     int st = L2P_OK;
-    for (int i = 0; !st && rf->animated && i < rf->count; i++)
+    for (int i = 0; !st && c->povray_args && i < rf->count; i++)
         st = outfile_check_path(rf->frame[i].output, err);
     return st;
 }
@@ -406,7 +407,7 @@ int render_command(const cli *given, l2p_error *err)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     resolved.povray_args = args;
     render_frames rf;
-    if ((st = render_frames_plan(c, &rf, err)) || (st = check_frame_outputs(&rf, err))) {
+    if ((st = render_frames_plan(c, &rf, err)) || (st = check_frame_outputs(c, &rf, err))) {
         render_frames_free(&rf);
         povargs_free(args);
         return st;
