@@ -238,9 +238,7 @@ static povray_chunk *chunk_list(const writer *w, int count, long long faces,
             named = povargs_frame_name(exr, f->number, tf->digits);
         }
         pc[k] = (povray_chunk){inc, ini, named, faces, f->placement, f->number, pov};
-        if (!inc || !ini || !named) {
-            if (!named)
-                free(pov);
+        if (!inc || !ini || !named) {   /* pov, when set, is freed with the list */
             free_chunk_list(pc, k + 1);
             return NULL;
         }
