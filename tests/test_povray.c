@@ -78,7 +78,7 @@ static void make_chunks(fixture *fx, const char *dir, int count, const int *dz)
         char *exr = fmt("%s/%s.exr", dir, name);
         write_include(inc, dz[i]);
         write_ini(ini, exr);
-        fx->chunk[i] = (povray_chunk){inc, ini, exr, 8};
+        fx->chunk[i] = (povray_chunk){inc, ini, exr, 8, NULL, -1, NULL};
         fx->paths[3 * i] = inc, fx->paths[3 * i + 1] = ini, fx->paths[3 * i + 2] = exr;
     }
 }
@@ -92,7 +92,7 @@ static void free_fixture(fixture *fx)
 
 static povray_options options(const char *scene, const char *work_dir, int jobs)
 {
-    return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL};
+    return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL, NULL, 0, 0, 0};
 }
 
 /* The one-chunk table of make_chunks rendered from dir with scene, one job. */

@@ -2,7 +2,7 @@
 # make bench: the tracer's figures; lens2pov trace against POV-Ray's parse of the same
 # 1e6-ray include (the target: trace at no more than 10% of POV-Ray's time); lens2pov render
 # against POV-Ray's own camera on the same view and primary rays (target: 1.5 or less), and
-# one POV-Ray process against two.
+# one POV-Ray process against two; then an animation (tools/bench_anim.sh).
 set -e
 build=${1:-build}
 work=$(mktemp -d "${TMPDIR:-/tmp}/l2pbench.XXXXXX")
@@ -75,3 +75,5 @@ awk -v a="$(middle $lens_t)" -v b="$(middle $pov_t)" -v r="$(middle $ratio)" -v 
 echo "   ratios of the three turns:$ratio"
 awk -v a="$(middle $one_t)" -v b="$(middle $lens_t)" -v r="$(middle $speedup)" 'BEGIN {
   printf "chunked parallel parse: --jobs 1: %.2f s, --jobs 2: %.2f s, speed-up %.2f\n", a, b, r }'
+
+sh tools/bench_anim.sh "$build"

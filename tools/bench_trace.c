@@ -179,7 +179,7 @@ static void bench_write(const char *lens_path, const char *dir)
     snprintf(inc, sizeof inc, "%s.inc", prefix);
     double t[5];
     raytable_stats st = {0, 0, 0, 0};
-    const raytable_request q = {prefix, NULL, 0, false, NULL};
+    const raytable_request q = {prefix, NULL, 0, false, NULL, NULL};
     for (int run = 0; run < 5; run++) {
         l2p_error err;
         if (raytable_write(&c, &q, &st, &err)) {

@@ -321,6 +321,11 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unknown command '%s' (see --help)", cmd_name);
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
+        if (!strcmp(a, "--")) {   /* the rest is POV-Ray's (render checks it) */
+            c->povray_args = argv + i + 1;
+            c->povray_arg_count = argc - i - 1;
+            break;
+        }
         if (a[0] != '-' || a[1] == '\0') {
             if (c->positional_count == CLI_MAX_POSITIONAL)
                 return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "unexpected argument '%s'", a);

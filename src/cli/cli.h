@@ -28,6 +28,8 @@ typedef struct cli {
     double angle_deg;            /* --angle: the horizontal field of view; NAN: not given */
     bool angle_scene;            /* --angle scene: the scene camera's */
     bool diagonal_given;         /* --film-diagonal (it contradicts --angle) */
+    char *const *povray_args;    /* render: POV-Ray's own options, after "--" */
+    int povray_arg_count;
 } cli;
 
 /* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render): an

@@ -15,8 +15,14 @@ int framing_from_scene(cli *c, const char *scene, l2p_error *err)
     int st = scene_camera_check_includes(scene, err);
     if (!st)
         st = scene_camera_read(scene, c->cam.width, c->cam.height, &sc, err);
-    if (st)
-        return st;
+    if (!st)
+        framing_apply(c, &sc);
+    return st;
+}
+
+void framing_apply(cli *c, const scene_camera *s)
+{
+    const scene_camera sc = *s;
     if (!c->placed) {
         /* The look-at point on the axis at the focus distance: camera_setup's default focus. */
         c->cam.location = sc.location;
@@ -26,7 +32,6 @@ int framing_from_scene(cli *c, const char *scene, l2p_error *err)
     }
     if (c->angle_scene)
         c->angle_deg = sc.hfov_deg;
-    return L2P_OK;
 }
 
 /* The film half width, mm, at which the horizontal half field of cam is half_deg: bisection

@@ -6,12 +6,16 @@
 #include "camera/camera.h"
 #include "cli/cli.h"
 #include "base/error.h"
+#include "povray/scenecam.h"
 
 /* Reads the scene's camera (src/povray/scenecam.h) when the placement or --angle scene needs
    it, and sets c->cam from it: the lens at the camera's location, looking along its
    direction, its film up along the camera's up, mirrored when the camera's right is, focused
    on the look_at point. */
 int framing_from_scene(cli *c, const char *scene, l2p_error *err);
+
+/* The same from a scene camera already read (one frame of an animation). */
+void framing_apply(cli *c, const scene_camera *sc);
 
 /* camera_setup for the command line: with --angle, the film diagonal that makes the lens's
    horizontal field of view, traced with real rays at the focus in effect, the angle asked

@@ -14,6 +14,7 @@ static const char usage[] =
     "  lens2pov trace LENS [camera options] -o PREFIX [--rays FILE.csv] [--memory-mb MB]\n"
     "  lens2pov develop PREFIX [RENDER.exr ...] -o IMAGE   (.png, .exr or .tif)\n"
     "  lens2pov render SCENE.pov LENS [camera options] -o IMAGE [--jobs N] [--keep-temp DIR]\n"
+    "                  [-- POV-Ray options: +KFI1 +KFF10, Declare=N=V, +L, FILE.ini, ...]\n"
     "  lens2pov COMMAND --help      (its options and their defaults)\n"
     "  lens2pov --version\n"
     "See README.md and docs/ for the conventions.\n";
@@ -30,8 +31,11 @@ static const struct {
     {"develop", "usage: lens2pov develop PREFIX [RENDER.exr ...] -o IMAGE\n"
                 "Weights and averages POV-Ray's renders of PREFIX's ray table into IMAGE\n"
                 "(.png, .exr or .tif) [RENDER.exr: the names PREFIX's .ini files give].\n"},
-    {"render", "usage: lens2pov render SCENE.pov LENS [camera options] -o IMAGE\n"
-               "trace, POV-Ray and develop in one, POV-Ray in parallel chunks.\n"},
+    {"render", "usage: lens2pov render SCENE.pov LENS [camera options] -o IMAGE [-- POV-Ray options]\n"
+               "trace, POV-Ray and develop in one, POV-Ray in parallel chunks.\n"
+               "  -- OPTIONS                    POV-Ray's own, for every run: animation (+KFI, +KFF,\n"
+               "                                +KI, +KF, +KC, +K), Declare=, +L, +Q, FILE.ini;\n"
+               "                                an animation gives IMAGE01.png, IMAGE02.png, ...\n"},
 };
 
 /* lens2pov COMMAND ... --help (or -h anywhere after the command): true when printed. */
@@ -74,6 +78,10 @@ int main(int argc, char **argv)
     if (st)
         return fail(&err);
     const char *cmd = argv[1];
+    if (c.povray_args && strcmp(cmd, "render")) {
+        l2p_fail(&err, L2P_BAD_INPUT, NULL, 0, "options after -- are POV-Ray's: only render takes them");
+        return fail(&err);
+    }
     if (!strcmp(cmd, "info"))
         st = info_command(&c, &err);
     else if (!strcmp(cmd, "trace"))

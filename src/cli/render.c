@@ -15,9 +15,11 @@
 #include "camera/camera.h"
 #include "cli/framing.h"
 #include "cli/lens_lookup.h"
+#include "cli/frames.h"
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "base/outfile.h"
+#include "povray/povargs.h"
 #include "povray/povray.h"
 #include "raytable/chunk_name.h"
 #include "cli/sizecheck.h"
@@ -58,8 +60,13 @@ static int check_inputs(const cli *c, l2p_error *err)
     if (!f)
         return l2p_fail(err, L2P_BAD_INPUT, c->positional[0], 0, "cannot read: %s", strerror(errno));
     fclose(f);
-    /* Before any work: a render of minutes must not fail at its last step. */
-    int st = outfile_check_path(c->output, err);
+    int st = povargs_check(c->povray_args, c->povray_arg_count, err);
+    if (st)
+        return st;
+    /* Before any work: a render of minutes must not fail at its last step (a frame's
+       picture is checked once its name is known). */
+    if (!c->povray_args)
+        st = outfile_check_path(c->output, err);
     if (!st && c->rays_csv)
         st = outfile_check_path(c->rays_csv, err);
     if (!st && c->keep_temp)
@@ -161,9 +168,12 @@ typedef struct writer {
     const camera *cam;
     const cli *c;
     char prefix[8192], csv[8300];
+    bool with_csv;             /* --rays: the first table's */
+    const char *placement;     /* the transform the table is moved by; NULL: none */
     long long chunk_faces;
     pthread_mutex_t lock;
     int ready, total;          /* chunks complete; their count once done (-1 before) */
+    int frames;                /* rendered through each chunk: one POV-Ray job a frame */
     atomic_bool stop;          /* from the renderer: stop at the next row */
     int status;
     l2p_error err;
@@ -183,8 +193,8 @@ static void *write_table(void *arg)
     writer *w = arg;
     l2p_error err;
     const raytable_stream stream = {chunk_done, w, &w->stop};
-    const raytable_request q = {w->prefix, w->c->rays_csv ? w->csv : NULL, w->chunk_faces,
-                                !w->c->quiet, &stream};
+    const raytable_request q = {w->prefix, w->c->rays_csv && w->with_csv ? w->csv : NULL,
+                                w->chunk_faces, !w->c->quiet, &stream, w->placement};
     raytable_stats stats;
     const int st = raytable_write(w->cam, &q, &stats, &err);
     pthread_mutex_lock(&w->lock);
@@ -200,8 +210,8 @@ static int chunks_ready(void *ctx, int *ready, int *total, l2p_error *err)
 {
     writer *w = ctx;
     pthread_mutex_lock(&w->lock);
-    *ready = w->ready;
-    *total = w->total;
+    *ready = w->ready * w->frames;   /* jobs are chunk-major: a chunk's frames together */
+    *total = w->total < 0 ? -1 : w->total * w->frames;
     const int st = w->status;
     if (st)
         *err = w->err;
@@ -222,44 +232,65 @@ static void free_chunk_list(povray_chunk *pc, int count)
         free((char *)pc[i].include_path);
         free((char *)pc[i].ini_path);
         free((char *)pc[i].output_exr);
+        free((char *)pc[i].pov_output);
     }
     free(pc);
 }
 
-/* The chunks the writer will write, by name; NULL out of memory. */
-static povray_chunk *chunk_list(const writer *w, int count, long long faces)
+/* The frames seen through one table, and what their pictures are named by. */
+typedef struct table_frames {
+    const render_frame **frame;
+    int count, digits;
+} table_frames;
+
+/* One POV-Ray job for every chunk the writer will write and every frame, by name, chunk-major
+   (job k renders chunk k / frames): a chunk's frames can start as soon as it is written. An
+   animation frame's render is named as POV-Ray names it (+O with the frame number added).
+   NULL out of memory. */
+static povray_chunk *chunk_list(const writer *w, int count, long long faces,
+                                const table_frames *tf)
 {
-    povray_chunk *pc = calloc((size_t)count, sizeof *pc);
-    for (int i = 0; pc && i < count; i++) {
+    const int n = count * tf->count;
+    povray_chunk *pc = calloc((size_t)n, sizeof *pc);
+    for (int k = 0; pc && k < n; k++) {
+        const int i = k / tf->count;
+        const render_frame *f = tf->frame[k % tf->count];
         char *inc = chunk_file_name(w->prefix, i, "inc");
         char *ini = chunk_file_name(w->prefix, i, "ini");
-        char *exr = chunk_file_name(w->prefix, i, "exr");
-        pc[i] = (povray_chunk){inc, ini, exr, faces};
-        if (!inc || !ini || !exr) {
-            free_chunk_list(pc, i + 1);
+        char *exr = chunk_file_name(w->prefix, i, "exr"), *named = exr, *pov = NULL;
+        if (exr && f->number >= 0) {
+            pov = exr;
+            named = povargs_frame_name(exr, f->number, tf->digits);
+        }
+        pc[k] = (povray_chunk){inc, ini, named, faces, f->placement, f->number, pov};
+        if (!inc || !ini || !named) {   /* pov, when set, is freed with the list */
+            free_chunk_list(pc, k + 1);
             return NULL;
         }
     }
     return pc;
 }
 
-/* Every chunk's EXR developed into the output through the writer's sample map. */
-static int develop_chunks(const cli *c, const writer *w, const povray_chunk *pc, int count,
-                          l2p_error *err)
+/* Every frame's renders, one a chunk, developed into its picture through the writer's sample
+   map. */
+static int develop_frames(const writer *w, const povray_chunk *pc, int chunks,
+                          const table_frames *tf, l2p_error *err)
 {
-    const char **exrs = calloc((size_t)(count > 0 ? count : 1), sizeof *exrs);
+    const char **exrs = calloc((size_t)(chunks > 0 ? chunks : 1), sizeof *exrs);
     if (!exrs)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int i = 0; i < count; i++)
-        exrs[i] = pc[i].output_exr;
     char map_path[8300];
     snprintf(map_path, sizeof map_path, "%s.map", w->prefix);
     samplemap map;
     int st = samplemap_read(map_path, &map, err);
-    if (!st) {
-        st = develop_files(&map, exrs, count, c->output, err);
-        samplemap_free(&map);
+    const bool read = st == L2P_OK;
+    for (int f = 0; !st && f < tf->count; f++) {
+        for (int i = 0; i < chunks; i++)
+            exrs[i] = pc[i * tf->count + f].output_exr;
+        st = develop_files(&map, exrs, chunks, tf->frame[f]->output, err);
     }
+    if (read)
+        samplemap_free(&map);
     free(exrs);
     return st;
 }
@@ -301,17 +332,24 @@ static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
     return r;
 }
 
-/* Writes the table and renders its chunks side by side, then develops them. */
+/* Writes one table and renders its chunks for each of its frames side by side, then develops
+   them. */
 static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
-                            outfile *csv, l2p_error *err)
+                            outfile *csv, const table_frames *tf, int table, l2p_error *err)
 {
-    writer w = {.cam = cam, .c = c, .total = -1};
-    snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
+    writer w = {.cam = cam, .c = c, .total = -1, .frames = tf->count, .with_csv = table == 0};
+    if (table == 0)
+        snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
+    else
+        snprintf(w.prefix, sizeof w.prefix, "%s/rays.t%d", ws->dir, table);
     snprintf(w.csv, sizeof w.csv, "%s/rays.csv", ws->dir);
+    w.placement = tf->frame[0]->placement ? "Lens2pov_Placement" : NULL;
     atomic_init(&w.stop, false);
     int count;
-    w.chunk_faces = chunk_faces_for(cam, c, jobs, &count);
-    povray_chunk *pc = chunk_list(&w, count, w.chunk_faces);
+    /* Each frame is a job of its own: chunks beyond the jobs would only add parses. */
+    const int chunk_jobs = (jobs + tf->count - 1) / tf->count;
+    w.chunk_faces = chunk_faces_for(cam, c, chunk_jobs, &count);
+    povray_chunk *pc = chunk_list(&w, count, w.chunk_faces, tf);
     if (!pc)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     pthread_mutex_init(&w.lock, NULL);
@@ -323,21 +361,59 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         /* Every process may use every core: the chunks cost the same to parse but not to shade
            (sky against floor), and a process left shading alone then gets the idle cores. */
         const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
-                                   !c->quiet, NULL, chunks_ready, &w};
+                                   !c->quiet, NULL, chunks_ready, &w, c->povray_args,
+                                   c->povray_arg_count, c->cam.width, c->cam.height};
         if (!st)
-            st = povray_render_chunks(pc, count, &po, err);
+            st = povray_render_chunks(pc, count * tf->count, &po, err);
         if (st)
             atomic_store(&w.stop, true);
         pthread_join(thread, NULL);
         if (!st && w.status)   /* failed after its last chunk: the map or the CSV */
             st = l2p_fail(err, w.status, NULL, 0, "%s", w.err.text);
         if (!st)
-            st = develop_chunks(c, &w, pc, w.total, err);
-        if (!st && c->rays_csv)
+            st = develop_frames(&w, pc, w.total, tf, err);
+        if (!st && c->rays_csv && table == 0)
             st = publish_csv(w.csv, csv, err);
     }
     pthread_mutex_destroy(&w.lock);
-    free_chunk_list(pc, count);
+    free_chunk_list(pc, count * tf->count);
+    return st;
+}
+
+/* Table t: its camera, then its frames. */
+static int render_table(const render_frames *rf, int t, const workspace *ws, int jobs,
+                        outfile *csv, l2p_error *err)
+{
+    table_frames tf = {calloc((size_t)rf->count, sizeof *tf.frame), 0, 1};
+    if (!tf.frame)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i = 0; i < rf->count; i++)
+        if (rf->frame[i].table == t)
+            tf.frame[tf.count++] = &rf->frame[i];
+    tf.digits = rf->digits;
+    const cli *c = &tf.frame[0]->table_cli;
+    lens l;
+    camera cam;
+    int st = lens_read_named(c->positional[1], &l, err);
+    if (!st) {
+        if (!(st = framing_camera_setup(&cam, &l, c, err))) {
+            if (t == 0)
+                cli_warn(c, &cam);
+            st = trace_and_render(c, &cam, ws, jobs, csv, &tf, t, err);
+        }
+        camera_free(&cam);   /* also after a failed setup, as it always was */
+    }
+    free(tf.frame);
+    return st;
+}
+
+/* Every frame's picture can be written: checked before any work (without POV-Ray's options
+   the one picture was checked with the other inputs). */
+static int check_frame_outputs(const cli *c, const render_frames *rf, l2p_error *err)
+{
+    int st = L2P_OK;
+    for (int i = 0; !st && c->povray_args && i < rf->count; i++)
+        st = outfile_check_path(rf->frame[i].output, err);
     return st;
 }
 
@@ -350,18 +426,19 @@ int render_command(const cli *given, l2p_error *err)
                                err);
     if (st)
         return st;
-    cli placed = *given;   /* with the scene camera's placement */
-    const cli *c = &placed;
-    lens l;
-    if ((st = framing_from_scene(&placed, c->positional[0], err)) ||
-        (st = lens_read_named(c->positional[1], &l, err)))
-        return st;
-    camera cam;
-    if ((st = framing_camera_setup(&cam, &l, c, err))) {
-        camera_free(&cam);
+    cli resolved = *given;   /* POV-Ray's options with paths that hold in the scene's folder */
+    const cli *c = &resolved;
+    char **args = given->povray_args ? povargs_resolve(given->povray_args,
+                                                       given->povray_arg_count) : NULL;
+    if (given->povray_args && !args)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    resolved.povray_args = args;
+    render_frames rf;
+    if ((st = render_frames_plan(c, &rf, err)) || (st = check_frame_outputs(c, &rf, err))) {
+        render_frames_free(&rf);
+        povargs_free(args);
         return st;
     }
-    cli_warn(c, &cam);
     pthread_t loader;
     if (start_thread(&loader, load_image_library, NULL) == 0)
         pthread_detach(loader);   /* image_io_ready waits for it */
@@ -369,10 +446,12 @@ int render_command(const cli *given, l2p_error *err)
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
         !(st = make_workspace(&w, c, err))) {
-        st = trace_and_render(c, &cam, &w, jobs, &csv, err);
+        for (int t = 0; !st && t < rf.tables; t++)
+            st = render_table(&rf, t, &w, jobs, &csv, err);
         remove_workspace(&w);
     }
     outfile_discard(&csv);   /* nothing when committed */
-    camera_free(&cam);
+    render_frames_free(&rf);
+    povargs_free(args);
     return st;
 }

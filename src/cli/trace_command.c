@@ -45,7 +45,7 @@ int trace_command(const cli *given, l2p_error *err)
     raytable_stats stats;
     /* One include unless --memory-mb asks for chunks that fit a POV-Ray process each. */
     const long long chunk_faces = c->memory_mb > 0 ? raytable_faces_for_memory(c->memory_mb) : 0;
-    const raytable_request q = {c->output, c->rays_csv, chunk_faces, !c->quiet, NULL};
+    const raytable_request q = {c->output, c->rays_csv, chunk_faces, !c->quiet, NULL, NULL};
     st = raytable_write(&cam, &q, &stats, err);
     if (!st && !c->quiet)
         fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%), %.2f s\n",

@@ -19,6 +19,7 @@
 #include "base/cleanup.h"
 #include "base/outfile.h"
 #include "base/progress.h"
+#include "povray/povray_cmd.h"
 #include "povray/povray_log.h"
 #include "raytable/chunk_name.h"
 
@@ -27,65 +28,6 @@ enum {
     DRAW_EVERY_TICKS = 12,     /* redraw the bar 4 times a second */
     STOP_WAIT_TICKS = 250      /* SIGTERM, then 5 s, then SIGKILL */
 };
-
-/* ---------------------------------------------------------------- small strings and paths */
-
-static char *str_printf(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static char *str_printf(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    const int n = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
-    if (s) {
-        va_start(ap, fmt);
-        vsnprintf(s, (size_t)n + 1, fmt, ap);
-        va_end(ap);
-    }
-    return s;
-}
-
-/* The child runs in the scene's folder, so every path it gets must be absolute. */
-static char *absolute_path(const char *path)
-{
-    if (path[0] == '/')
-        return strdup(path);
-    char cwd[4096];
-    if (!getcwd(cwd, sizeof cwd))
-        return NULL;
-    return str_printf("%s/%s", cwd, path);
-}
-
-static char *folder_of(const char *abs_path)
-{
-    char *d = strdup(abs_path);
-    char *slash = d ? strrchr(d, '/') : NULL;
-    if (slash)
-        slash[slash == d ? 1 : 0] = '\0';
-    return d;
-}
-
-bool povray_path_is_plain(const char *path)
-{
-    for (const unsigned char *p = (const unsigned char *)path; *p; p++)
-        if (*p < 0x20 || *p > 0x7e || *p == '"' || *p == '\\')
-            return false;
-    return true;
-}
-
-bool povray_ini_can_carry(const char *path)
-{
-    for (const unsigned char *p = (const unsigned char *)path; *p; p++)
-        if (*p < 0x20 || *p > 0x7e || *p == '"')
-            return false;
-    return true;
-}
-
-bool povray_ini_needs_quotes(const char *path)
-{
-    return strpbrk(path, ";#',") != NULL;
-}
 
 /* ---------------------------------------------------------------- the run's shared state */
 
@@ -253,25 +195,6 @@ static int prepare_run(run *r, const povray_chunk *chunks, int count, const povr
 
 /* ---------------------------------------------------------------- one chunk's files */
 
-/* The wrapper: the scene first, then the camera, so that the lens camera replaces the
-   scene's own. Nothing about #version or gamma here: the camera include raises the language
-   version only when it is below 3.7 and restores it (an unversioned scene must stay one). */
-static int write_wrapper(const char *path, const char *scene, const char *include, int index,
-                         l2p_error *err)
-{
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
-    fprintf(f,
-            "// lens2pov: the scene seen through chunk %d of the lens camera. The camera is\n"
-            "// declared after the scene, so it replaces the scene's own camera.\n"
-            "#include \"%s\"\n#include \"%s\"\n", index, scene, include);
-    const bool bad = ferror(f) != 0;
-    if (fclose(f) != 0 || bad)
-        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
-    return L2P_OK;
-}
-
 typedef struct chunk_args {
     char *wrapper, *ini, *output;
 } chunk_args;
@@ -292,7 +215,7 @@ static int prepare_chunk(run *r, int index, chunk_args *a, l2p_error *err)
     char *ini_name = chunk_file_name("povray", index, "ini");
     char *pov_inc = NULL;
     a->wrapper = chunk_file_name(r->chunk_prefix, index, "pov");
-    a->output = absolute_path(c->output_exr);
+    a->output = absolute_path(c->pov_output ? c->pov_output : c->output_exr);
     int st = include && ini && inc_name && ini_name && a->wrapper && a->output
                  ? L2P_OK : out_of_memory(err);
     if (!st && (access(include, R_OK) != 0 || access(ini, R_OK) != 0))
@@ -301,13 +224,14 @@ static int prepare_chunk(run *r, int index, chunk_args *a, l2p_error *err)
     if (!st)
         st = check_plain(a->output, err);
     if (!st)
-        unlink(a->output);  /* a stale EXR must not pass for this run's */
+        unlink(c->output_exr);  /* a stale EXR must not pass for this run's */
     if (!st)
         st = readable_for_povray(r, include, inc_name, &pov_inc, err);
     if (!st)
         st = readable_for_povray(r, ini, ini_name, &a->ini, err);
     if (!st)
-        st = write_wrapper(a->wrapper, r->scene_for_povray, pov_inc, index, err);
+        st = povray_write_wrapper(a->wrapper, r->scene_for_povray, pov_inc, index, c, r->opts,
+                                  err);
     free(include);
     free(ini);
     free(inc_name);
@@ -317,46 +241,6 @@ static int prepare_chunk(run *r, int index, chunk_args *a, l2p_error *err)
 }
 
 /* ---------------------------------------------------------------- processes */
-
-/* The command line. Options after the chunk's ini override it and any povray.ini: no display,
-   no pause, no continuing an old render, no alpha (it zeroes the background), no
-   antialiasing (it mixes neighbouring rays), +V for the progress lines, -GS -GR for no
-   statistics, EXR, and Display_Gamma=sRGB, which sets how a scene without gamma handling
-   is decoded into the linear EXR. Paths are quoted for spaces. */
-static char **povray_argv(const run *r, const chunk_args *a)
-{
-    enum { ARGS = 20 };
-    char **argv = calloc(ARGS, sizeof *argv);
-    if (!argv)
-        return NULL;
-    int n = 0;
-    argv[n++] = strdup(r->exe);
-    argv[n++] = str_printf("\"%s\"", a->ini);
-    argv[n++] = str_printf("+I\"%s\"", a->wrapper);
-    argv[n++] = str_printf("+O\"%s\"", a->output);
-    argv[n++] = str_printf("+L\"%s\"", r->scene_dir_for_povray);
-    const char *fixed[] = {"-D", "-P", "-C", "-UA", "-A", "+V", "-GS", "-GR", "+FE",
-                           "Display_Gamma=sRGB"};
-    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
-        argv[n++] = strdup(fixed[i]);
-    if (r->opts->threads_per_job > 0)
-        argv[n++] = str_printf("+WT%d", r->opts->threads_per_job);
-    for (int i = 0; i < n; i++)
-        if (!argv[i]) {
-            for (int k = 0; k < n; k++)
-                free(argv[k]);
-            free(argv);
-            return NULL;
-        }
-    return argv;
-}
-
-static void free_argv(char **argv)
-{
-    for (int i = 0; argv && argv[i]; i++)
-        free(argv[i]);
-    free(argv);
-}
 
 static void write_text(int fd, const char *a, const char *b)
 {
@@ -412,7 +296,8 @@ static int start_job(run *r, job *j, int index, l2p_error *err)
 {
     chunk_args a;
     int st = prepare_chunk(r, index, &a, err);
-    char **argv = st ? NULL : povray_argv(r, &a);
+    const povray_cmd cmd = {r->exe, a.ini, a.wrapper, a.output, r->scene_dir_for_povray};
+    char **argv = st ? NULL : povray_argv(&cmd, &r->chunks[index], r->opts);
     free(j->log_path);
     j->log_path = chunk_file_name(r->chunk_prefix, index, "log");
     if (!st && (!argv || !j->log_path))
@@ -431,7 +316,7 @@ static int start_job(run *r, job *j, int index, l2p_error *err)
     }
     if (fd >= 0)
         close(fd);
-    free_argv(argv);
+    povray_free_argv(argv);
     free_chunk_args(&a);
     return st;
 }

@@ -23,6 +23,13 @@ typedef struct povray_chunk {
     const char *ini_path;      /* its settings (Width, Height, -A, +FE, ...) */
     const char *output_exr;    /* where POV-Ray writes the chunk's render */
     long long faces;           /* for progress and memory estimates */
+    /* The wrapper's text between the scene and the include (an animation frame's placement),
+       NULL: none. An animation frame also has pov_output, what +O names, to which POV-Ray
+       adds the frame number, writing output_exr; and the frame rendered (+SF, +EF). NULL:
+       not an animation, +O is output_exr. */
+    const char *placement;
+    int frame;
+    const char *pov_output;
 } povray_chunk;
 
 typedef struct povray_options {
@@ -37,6 +44,9 @@ typedef struct povray_options {
        povray_render_chunks). Nonzero: the writer failed, with err set. */
     int (*chunks_ready)(void *ctx, int *ready, int *total, l2p_error *err);
     void *ctx;
+    char *const *user_args;    /* POV-Ray's own options from the command line, before ours */
+    int user_arg_count;
+    int film_width, film_height;   /* image_width, image_height in the scene; 0: not declared */
 } povray_options;
 
 /* Writes, for every chunk, a wrapper that includes the scene and then the chunk's camera, and

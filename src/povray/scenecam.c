@@ -1,23 +1,12 @@
 /* The scene's camera: POV-Ray parses a copy of the scene whose camera statements print their
-   items (scenecam_text.c); here the copy is run and POV-Ray 3.7's camera rules are applied to
-   the items of the last statement that ran. */
+   items (scenecam_text.c), run by scenecam_run.c; here POV-Ray 3.7's camera rules are applied
+   to the items of the last statement that ran. */
 #include "povray/scenecam.h"
 
-#include <errno.h>
-#include <fcntl.h>
-#include <pthread.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/prctl.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
-#include "base/cleanup.h"
-#include "base/outfile.h"
-#include "povray/povray_log.h"
 
 /* POV-Ray's EPSILON in the camera code. */
 #define POV_EPSILON 1e-10
@@ -307,180 +296,43 @@ int scene_camera_from_log(const char *log, size_t n, const char *scene, scene_ca
     return st ? st : to_scene_camera(&c, scene, line, out, err);
 }
 
-/* ---------------------------------------------------------------- running POV-Ray on the copy */
-
-static char *read_all(const char *path, size_t *n)
+/* One frame message: "lens2pov-frame NUMBER FINAL CLOCK". */
+static void take_frame(const char *msg, scene_frames *out, scene_frame *f)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 1 << 16, len = 0;
-    char *buf = malloc(cap);
-    for (size_t got; buf && (got = fread(buf + len, 1, cap - len, f)) > 0;) {
-        len += got;
-        char *grown = len == cap ? realloc(buf, cap *= 2) : buf;
-        if (!grown)
-            free(buf);
-        buf = grown;
+    int number = 0, final = 0;
+    char clock[64] = "0";
+    sscanf(msg, "lens2pov-frame %d %d %63s", &number, &final, clock);
+    f->number = number;
+    f->clock = strtod(clock, NULL);
+    if (final > 0) {   /* POV-Ray declares final_frame only in an animation */
+        out->animated = true;
+        out->final_frame = final;
     }
-    fclose(f);
-    if (buf)
-        *n = len;
-    return buf;
 }
 
-static int write_all(const char *path, const char *s, l2p_error *err)
+int scene_frames_from_log(const char *log, size_t n, const char *scene, scene_frames *out,
+                          l2p_error *err)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
-    const bool ok = fwrite(s, 1, strlen(s), f) == strlen(s);
-    if (fclose(f) != 0 || !ok)
-        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
-    return L2P_OK;
-}
-
-static bool plain_path(const char *p)
-{
-    for (; *p; p++)
-        if (*p < 0x20 || *p > 0x7e || *p == '"' || *p == '\\')
-            return false;
-    return true;
-}
-
-/* POV-Ray parses the copy in the scene's folder, as the render will run it: the same
-   povray.ini, the same includes. One pixel is traced; the parse is what counts. */
-static int run_probe(const char *dir, const char *copy, const char *log, int w, int h,
-                     l2p_error *err)
-{
-    const char *exe = getenv("LENS2POV_POVRAY");
-    exe = exe && *exe ? exe : "povray";
-    char in[4300], size_w[32], size_h[32], rows[64], cols[64];
-    snprintf(in, sizeof in, "+I\"%s\"", copy);
-    snprintf(size_w, sizeof size_w, "+W%d", w);
-    snprintf(size_h, sizeof size_h, "+H%d", h);
-    /* +SR2: a whole number above 1 is a pixel, 1 itself the fraction 1.0 */
-    snprintf(rows, sizeof rows, "+SR%d", h > 1 ? 2 : 1);
-    snprintf(cols, sizeof cols, "+SC%d", w > 1 ? 2 : 1);
-    char end_rows[64], end_cols[64];
-    snprintf(end_rows, sizeof end_rows, "+ER%d", h > 1 ? 2 : 1);
-    snprintf(end_cols, sizeof end_cols, "+EC%d", w > 1 ? 2 : 1);
-    char *argv[] = {(char *)exe, in, size_w, size_h, rows, end_rows, cols, end_cols, "-F", "-D",
-                    "-P", "-C", "-A", "-GS", "-GR", "+GD", NULL};
-    const int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0)
-        return l2p_fail(err, L2P_FAILED, log, 0, "cannot write: %s", strerror(errno));
-    sigset_t old;
-    cleanup_block_signals(&old);
-    const pid_t pid = fork();
-    if (pid == 0) {
-        prctl(PR_SET_PDEATHSIG, SIGTERM);   /* gone with lens2pov, however it ends */
-        signal(SIGINT, SIG_DFL);
-        signal(SIGTERM, SIG_DFL);
-        signal(SIGHUP, SIG_DFL);
-        sigprocmask(SIG_SETMASK, &old, NULL);
-        const int null_fd = open("/dev/null", O_RDONLY);
-        if (null_fd >= 0)
-            dup2(null_fd, STDIN_FILENO);
-        dup2(fd, STDOUT_FILENO);
-        dup2(fd, STDERR_FILENO);
-        if (chdir(dir) == 0)
-            execvp(exe, argv);
-        _exit(127);
+    memset(out, 0, sizeof *out);
+    char buf[4096];
+    int count = 0;
+    for (size_t pos = 0; next_message(log, n, &pos, buf, sizeof buf);)
+        count += !strncmp(buf, "lens2pov-frame ", 15);
+    out->frame = calloc((size_t)(count > 0 ? count : 1), sizeof *out->frame);
+    if (!out->frame)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    out->count = count > 0 ? count : 1;
+    int k = count > 0 ? -1 : 0, st = L2P_OK;
+    size_t start = 0, pos = 0;
+    for (size_t at = 0; !st && next_message(log, n, &pos, buf, sizeof buf); at = pos) {
+        if (strncmp(buf, "lens2pov-frame ", 15))
+            continue;
+        if (k >= 0)
+            st = scene_camera_from_log(log + start, at - start, scene, &out->frame[k].cam, err);
+        take_frame(buf, out, &out->frame[++k]);
+        start = at;
     }
-    if (pid > 0)
-        cleanup_track_child(pid);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
-    close(fd);
-    if (pid < 0)
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
-    int status;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
-        ;
-    cleanup_untrack_child(pid);
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "%s: cannot run it (install Debian's povray "
-                        "package) or cannot enter %s", exe, dir);
-    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? L2P_OK : -1;
-}
-
-static char *folder_of(const char *path)
-{
-    char *abs = NULL;
-    if (path[0] == '/') {
-        abs = strdup(path);
-    } else {
-        char cwd[4096];
-        if (getcwd(cwd, sizeof cwd) && (abs = malloc(strlen(cwd) + strlen(path) + 2)))
-            sprintf(abs, "%s/%s", cwd, path);
-    }
-    char *slash = abs ? strrchr(abs, '/') : NULL;
-    if (slash)
-        slash[slash == abs ? 1 : 0] = '\0';
-    return abs;
-}
-
-static int probe(const char *scene, const char *dir, const char *work, int w, int h,
-                 scene_camera *out, l2p_error *err)
-{
-    char copy[4200], log[4200];
-    snprintf(copy, sizeof copy, "%s/scene-camera.pov", work);
-    snprintf(log, sizeof log, "%s/scene-camera.log", work);
-    size_t n = 0;
-    char *text = read_all(scene, &n);
-    if (!text)
-        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
-    char *rewritten = memchr(text, '\0', n) ? NULL : scene_camera_rewrite(text, n);
-    const bool no_camera = rewritten && !strcmp(rewritten, text);
-    free(text);
-    if (!rewritten)
-        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file (or out of memory)");
-    if (no_camera) {   /* POV-Ray's default camera: nothing for POV-Ray to evaluate */
-        free(rewritten);
-        return scene_camera_from_log("", 0, scene, out, err);
-    }
-    int st = write_all(copy, rewritten, err);
-    free(rewritten);
-    if (!st) {
-        st = run_probe(dir, copy, log, w, h, err);
-        if (st < 0) {   /* POV-Ray's own error, in the user's file */
-            const povray_path_link link = {copy, (char *)scene};
-            const povray_log_names names = {scene, dir, {NULL, NULL}, &link, 1};
-            if (!povray_log_error(log, &names, err))
-                l2p_fail(err, L2P_FAILED, scene, 0, "POV-Ray failed reading the scene's camera");
-            st = L2P_FAILED;
-        }
-    }
-    char *out_log = st ? NULL : read_all(log, &n);
-    if (!st && !out_log)
-        st = l2p_fail(err, L2P_FAILED, log, 0, "cannot read: %s", strerror(errno));
     if (!st)
-        st = scene_camera_from_log(out_log, n, scene, out, err);
-    free(out_log);
-    unlink(copy);
-    unlink(log);
-    return st;
-}
-
-int scene_camera_read(const char *scene, int width, int height, scene_camera *out,
-                      l2p_error *err)
-{
-    if (access(scene, R_OK) != 0)
-        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
-    const char *tmp = getenv("TMPDIR");
-    char work[4096];
-    snprintf(work, sizeof work, "%s/lens2pov-camera.XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (!plain_path(work))
-        snprintf(work, sizeof work, "/tmp/lens2pov-camera.XXXXXX");
-    if (!mkdtemp(work))
-        return l2p_fail(err, L2P_FAILED, work, 0, "cannot make a temporary folder: %s",
-                        strerror(errno));
-    cleanup_track(work);
-    char *dir = folder_of(scene);
-    const int st = dir ? probe(scene, dir, work, width, height, out, err)
-                       : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    free(dir);
-    rmdir(work);
-    cleanup_untrack(work);
+        st = scene_camera_from_log(log + start, n - start, scene, &out->frame[k].cam, err);
     return st;
 }

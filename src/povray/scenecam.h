@@ -28,6 +28,32 @@ typedef struct scene_camera {
 int scene_camera_read(const char *scene_path, int width, int height, scene_camera *out,
                       l2p_error *err);
 
+/* One frame of an animation: its number and clock as POV-Ray computes them, and its camera. */
+typedef struct scene_frame {
+    int number;
+    double clock;
+    scene_camera cam;
+} scene_frame;
+
+typedef struct scene_frames {
+    scene_frame *frame;        /* in the order POV-Ray renders them */
+    int count;
+    bool animated;             /* POV-Ray numbers the frames' outputs (+KFI, +KFF, ...) */
+    int final_frame;           /* for the digits of those numbers */
+} scene_frames;
+
+/* scene_camera_read with POV-Ray's own options (args, given before lens2pov's): the frames
+   POV-Ray renders with them and each frame's camera. Without args and without a camera
+   statement, POV-Ray is not run (one frame, its default camera). */
+int scene_frames_read(const char *scene_path, int width, int height, char *const *args,
+                      int arg_count, scene_frames *out, l2p_error *err);
+void scene_frames_free(scene_frames *f);
+
+/* The frames of POV-Ray's output: from each "lens2pov-frame" message to the next, one
+   camera (scene_camera_from_log). */
+int scene_frames_from_log(const char *log, size_t n, const char *scene, scene_frames *out,
+                          l2p_error *err);
+
 /* The copy's text: every camera statement of text replaced by its #debug lines, on as many
    lines as the statement took, so that POV-Ray's messages keep their line numbers. */
 char *scene_camera_rewrite(const char *text, size_t n);

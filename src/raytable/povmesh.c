@@ -35,6 +35,7 @@ struct povmesh_emitter {
     long long faces;
     povmesh_chunk_hook hook;   /* told of each chunk as it is complete; NULL: none */
     void *hook_ctx;
+    const char *placement;     /* a transform identifier applied last; NULL: none */
     char edge_text[POVMESH_RAY_TEXT_MAX];   /* the last shared edge's two vertex lines */
     size_t edge_len;
     vec3 anchor_camera_mm;     /* the front vertex: vertices are written relative to it */
@@ -78,6 +79,11 @@ void povmesh_set_chunk_hook(povmesh_emitter *e, povmesh_chunk_hook hook, void *c
 {
     e->hook = hook;
     e->hook_ctx = ctx;
+}
+
+void povmesh_set_placement(povmesh_emitter *e, const char *transform_name)
+{
+    e->placement = transform_name;
 }
 
 static int begin_chunk(povmesh_emitter *e, l2p_error *err)
@@ -158,12 +164,13 @@ static int put_faces_of(const povmesh_emitter *e, const emitted_ray *r, int i, i
 static void put_camera(text_out *t, const povmesh_emitter *e)
 {
     const vec3 w = camera_world_from_camera_point(e->cam, e->anchor_camera_mm);
-    t->len += (size_t)snprintf(t->buf + t->len, 512,
+    t->len += (size_t)snprintf(t->buf + t->len, 768,
         "  hierarchy off\n}\ncamera {\n  mesh_camera {\n    1 0\n"
-        "    mesh { Lens2pov_Rays scale 1e-%d translate <%.17g, %.17g, %.17g> }\n  }\n}\n"
+        "    mesh { Lens2pov_Rays scale 1e-%d translate <%.17g, %.17g, %.17g>%s%s%s }\n  }\n}\n"
         "#undef Lens2pov_Rays\n"
         "#ifdef (Lens2pov_Version)\n  #version Lens2pov_Version;\n  #undef Lens2pov_Version\n#end\n",
-        e->decimals, w.x, w.y, w.z);
+        e->decimals, w.x, w.y, w.z, e->placement ? " transform { " : "",
+        e->placement ? e->placement : "", e->placement ? " }" : "");
 }
 
 /* The render's name, absolute: POV-Ray is run in the scene's folder, not in ours. */

@@ -67,6 +67,11 @@ bool povmesh_wants_csv(const povmesh_emitter *e);
 typedef int (*povmesh_chunk_hook)(void *ctx, int index);
 void povmesh_set_chunk_hook(povmesh_emitter *e, povmesh_chunk_hook hook, void *ctx);
 
+/* Every chunk's camera mesh is moved by the transform of this identifier after its own
+   translate (the scene declares it before the include: one table placed anew in each frame
+   of an animation). The name must stay valid while e writes. */
+void povmesh_set_placement(povmesh_emitter *e, const char *transform_name);
+
 /* The name of a chunk's file: PREFIX.EXT, or PREFIX.cNNN.EXT when chunked (malloc'd). */
 /* Checks, before any work, that the .ini files of the table at prefix can name its renders
    (absolute paths; povray_ini_can_carry): L2P_BAD_INPUT naming the path otherwise. */

@@ -244,6 +244,8 @@ int raytable_write(const camera *c, const raytable_request *q, raytable_stats *s
         return st;
     if (q->stream)
         povmesh_set_chunk_hook(e, q->stream->chunk_done, q->stream->ctx);
+    if (q->placement)
+        povmesh_set_placement(e, q->placement);
     progress bar;
     progress_start(&bar, "tracing", q->progress);
     st = trace_rows(c, e, q->stream ? q->stream->stop : NULL, &bar, &local, err);

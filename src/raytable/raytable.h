@@ -41,6 +41,7 @@ typedef struct raytable_request {
     long long chunk_faces;          /* as for povmesh_open: 0 is one chunk */
     bool progress;                  /* a bar on stderr */
     const raytable_stream *stream;  /* NULL: none */
+    const char *placement;          /* see povmesh_set_placement; NULL: none */
 } raytable_request;
 
 /* Traces crop pixels x spp samples and writes the table. Without a stream, all outputs appear

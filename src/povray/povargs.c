@@ -1,0 +1,130 @@
+#include "povray/povargs.h"
+
+#include <ctype.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+/* Switches (+X or -X, case-insensitive) lens2pov sets for the ray table: the image's size
+   (W, H: but WT, threads, and WL, warnings, are harmless), antialiasing (A...), output type
+   and file (F..., O...), crops (SR, SC, ER, EC) and the input (I). */
+static const char *refused_switch(const char *a)
+{
+    const char c0 = (char)toupper((unsigned char)a[1]), c1 = (char)toupper((unsigned char)a[2]);
+    if (c0 == 'W')
+        return c1 == 'T' || c1 == 'L' ? NULL : "the image's width";
+    if (c0 == 'H')
+        return "the image's height";
+    if (c0 == 'A')
+        return "antialiasing";
+    if (c0 == 'F')
+        return "the output file's type";
+    if (c0 == 'O')
+        return "the output file";
+    if (c0 == 'I')
+        return "the input file";
+    if ((c0 == 'S' || c0 == 'E') && (c1 == 'R' || c1 == 'C'))
+        return "a crop";
+    return NULL;
+}
+
+/* The INI keys (before '=') for the same settings. */
+static const char *refused_key(const char *a, size_t n)
+{
+    static const struct { const char *key; const char *what; } keys[] = {
+        {"Width", "the image's width"}, {"Height", "the image's height"},
+        {"Antialias", "antialiasing"}, {"Antialias_Threshold", "antialiasing"},
+        {"Antialias_Depth", "antialiasing"}, {"Antialias_Gamma", "antialiasing"},
+        {"Sampling_Method", "antialiasing"}, {"Jitter", "antialiasing"},
+        {"Jitter_Amount", "antialiasing"}, {"Output_File_Type", "the output file's type"},
+        {"Output_File_Name", "the output file"}, {"Output_To_File", "the output file"},
+        {"Output_Alpha", "the output file's alpha"}, {"Input_File_Name", "the input file"},
+        {"Start_Row", "a crop"}, {"End_Row", "a crop"}, {"Start_Column", "a crop"},
+        {"End_Column", "a crop"},
+    };
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
+        if (strlen(keys[i].key) == n && !strncasecmp(a, keys[i].key, n))
+            return keys[i].what;
+    return NULL;
+}
+
+int povargs_check(char *const *args, int count, l2p_error *err)
+{
+    for (int i = 0; i < count; i++) {
+        const char *a = args[i], *eq = strchr(a, '=');
+        const char *what = (a[0] == '+' || a[0] == '-') && a[1] ? refused_switch(a)
+                           : eq ? refused_key(a, (size_t)(eq - a)) : NULL;
+        if (what)
+            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                            "-- %s: lens2pov sets %s for its ray table (give the film's with "
+                            "--width, --height, --spp, --crop and -o)", a, what);
+    }
+    return L2P_OK;
+}
+
+/* head + path, the path made absolute when it is relative and exists here. */
+static char *resolved(const char *head, size_t head_len, const char *path)
+{
+    char cwd[4096];
+    const bool relative = path[0] && path[0] != '/' && access(path, F_OK) == 0 &&
+                          getcwd(cwd, sizeof cwd);
+    const size_t n = head_len + strlen(path) + (relative ? strlen(cwd) + 2 : 1);
+    char *s = malloc(n);
+    if (s)
+        snprintf(s, n, "%.*s%s%s%s", (int)head_len, head, relative ? cwd : "",
+                 relative ? "/" : "", path);
+    return s;
+}
+
+static char *resolve_one(const char *a)
+{
+    if ((a[0] == '+' || a[0] == '-') && (a[1] == 'L' || a[1] == 'l'))
+        return resolved(a, 2, a + 2);
+    const char *eq = strchr(a, '=');
+    if (eq && (size_t)(eq - a) == strlen("Library_Path") && !strncasecmp(a, "Library_Path", 12))
+        return resolved(a, (size_t)(eq - a) + 1, eq + 1);
+    if (!eq && a[0] != '+' && a[0] != '-')
+        return resolved("", 0, a);
+    return strdup(a);
+}
+
+char **povargs_resolve(char *const *args, int count)
+{
+    char **out = calloc((size_t)count + 1, sizeof *out);
+    for (int i = 0; out && i < count; i++)
+        if (!(out[i] = resolve_one(args[i]))) {
+            povargs_free(out);
+            return NULL;
+        }
+    return out;
+}
+
+void povargs_free(char **args)
+{
+    for (int i = 0; args && args[i]; i++)
+        free(args[i]);
+    free(args);
+}
+
+int povargs_frame_digits(int final_frame)
+{
+    int digits = 1;
+    for (int i = final_frame; i >= 10; i /= 10)
+        digits++;
+    return digits;
+}
+
+char *povargs_frame_name(const char *path, int frame, int digits)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        dot = path + strlen(path);
+    const size_t n = strlen(path) + 32;
+    char *s = malloc(n);
+    if (s)
+        snprintf(s, n, "%.*s%0*d%s", (int)(dot - path), path, digits, frame, dot);
+    return s;
+}

@@ -1,0 +1,27 @@
+/* POV-Ray's own options given after "--" to render: the ones that would break the ray table
+   are refused; the rest are passed to every POV-Ray run. And the names POV-Ray gives the
+   frames of an animation. */
+#ifndef LENS2POV_POVARGS_H
+#define LENS2POV_POVARGS_H
+
+#include "base/error.h"
+
+/* L2P_BAD_INPUT, naming "--" and the option, for an option that sets the image's size, its
+   antialiasing, crop, output file or type, or its input file: lens2pov sets those for the ray
+   table. Values are not checked here: POV-Ray checks them on its first run. */
+int povargs_check(char *const *args, int count, l2p_error *err);
+
+/* The options with relative paths made absolute from the current folder: POV-Ray runs in the
+   scene's folder. Library paths (+L, Library_Path=) and file names (an .ini, given alone)
+   that exist here. NULL-terminated, malloc'd (povargs_free); NULL out of memory. */
+char **povargs_resolve(char *const *args, int count);
+void povargs_free(char **args);
+
+/* The digits POV-Ray pads a frame number to: those of the final frame. */
+int povargs_frame_digits(int final_frame);
+
+/* path with the frame number before its extension, as POV-Ray names an animation's frames
+   (out.png, frame 3 of 10: out03.png); malloc'd, NULL out of memory. */
+char *povargs_frame_name(const char *path, int frame, int digits);
+
+#endif

@@ -1,0 +1,282 @@
+/* Running POV-Ray on the copy of the scene whose camera statements print their items
+   (scenecam_text.c), once for every frame POV-Ray's own options give, and reading each frame's
+   camera from what it printed (scenecam.c). */
+#include "povray/scenecam.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "base/cleanup.h"
+#include "base/outfile.h"
+#include "povray/povray_log.h"
+
+static char *read_all(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    for (size_t got; buf && (got = fread(buf + len, 1, cap - len, f)) > 0;) {
+        len += got;
+        char *grown = len == cap ? realloc(buf, cap *= 2) : buf;
+        if (!grown)
+            free(buf);
+        buf = grown;
+    }
+    fclose(f);
+    if (buf)
+        *n = len;
+    return buf;
+}
+
+static int write_all(const char *path, const char *s, l2p_error *err)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    const bool ok = fwrite(s, 1, strlen(s), f) == strlen(s);
+    if (fclose(f) != 0 || !ok)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    return L2P_OK;
+}
+
+static bool plain_path(const char *p)
+{
+    for (; *p; p++)
+        if (*p < 0x20 || *p > 0x7e || *p == '"' || *p == '\\')
+            return false;
+    return true;
+}
+
+/* POV-Ray parses the copy in the scene's folder, as the render will run it: the same
+   povray.ini, the same includes. One pixel is traced; the parse is what counts. */
+typedef struct probe_args {
+    char *const *user;         /* POV-Ray's own options from the command line, first */
+    int user_count;
+} probe_args;
+
+static int run_probe(const char *dir, const char *copy, const char *log, int w, int h,
+                     const probe_args *pa, l2p_error *err)
+{
+    const char *exe = getenv("LENS2POV_POVRAY");
+    exe = exe && *exe ? exe : "povray";
+    char in[4300], size_w[32], size_h[32], rows[64], cols[64];
+    snprintf(in, sizeof in, "+I\"%s\"", copy);
+    snprintf(size_w, sizeof size_w, "+W%d", w);
+    snprintf(size_h, sizeof size_h, "+H%d", h);
+    /* +SR2: a whole number above 1 is a pixel, 1 itself the fraction 1.0 */
+    snprintf(rows, sizeof rows, "+SR%d", h > 1 ? 2 : 1);
+    snprintf(cols, sizeof cols, "+SC%d", w > 1 ? 2 : 1);
+    char end_rows[64], end_cols[64];
+    snprintf(end_rows, sizeof end_rows, "+ER%d", h > 1 ? 2 : 1);
+    snprintf(end_cols, sizeof end_cols, "+EC%d", w > 1 ? 2 : 1);
+    char *own[] = {in, size_w, size_h, rows, end_rows, cols, end_cols, "-F", "-D",
+                   "-P", "-C", "-A", "-GS", "-GR", "+GD"};
+    enum { OWN = sizeof own / sizeof own[0] };
+    char **argv = calloc((size_t)pa->user_count + OWN + 2, sizeof *argv);
+    if (!argv)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    int n = 0;
+    argv[n++] = (char *)exe;
+    for (int i = 0; i < pa->user_count; i++)   /* before ours, which override them */
+        argv[n++] = pa->user[i];
+    for (int i = 0; i < OWN; i++)
+        argv[n++] = own[i];
+    const int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        free(argv);
+        return l2p_fail(err, L2P_FAILED, log, 0, "cannot write: %s", strerror(errno));
+    }
+    sigset_t old;
+    cleanup_block_signals(&old);
+    const pid_t pid = fork();
+    if (pid == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGTERM);   /* gone with lens2pov, however it ends */
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        signal(SIGHUP, SIG_DFL);
+        sigprocmask(SIG_SETMASK, &old, NULL);
+        const int null_fd = open("/dev/null", O_RDONLY);
+        if (null_fd >= 0)
+            dup2(null_fd, STDIN_FILENO);
+        dup2(fd, STDOUT_FILENO);
+        dup2(fd, STDERR_FILENO);
+        if (chdir(dir) == 0)
+            execvp(exe, argv);
+        _exit(127);
+    }
+    if (pid > 0)
+        cleanup_track_child(pid);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    close(fd);
+    free(argv);
+    if (pid < 0)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
+    int status;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    cleanup_untrack_child(pid);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "%s: cannot run it (install Debian's povray "
+                        "package) or cannot enter %s", exe, dir);
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? L2P_OK : -1;
+}
+
+static char *folder_of(const char *path)
+{
+    char *abs = NULL;
+    if (path[0] == '/') {
+        abs = strdup(path);
+    } else {
+        char cwd[4096];
+        if (getcwd(cwd, sizeof cwd) && (abs = malloc(strlen(cwd) + strlen(path) + 2)))
+            sprintf(abs, "%s/%s", cwd, path);
+    }
+    char *slash = abs ? strrchr(abs, '/') : NULL;
+    if (slash)
+        slash[slash == abs ? 1 : 0] = '\0';
+    return abs;
+}
+
+/* POV-Ray's options after "--" that POV-Ray itself refused ("Problem with option setting",
+   without naming the option): the message names them all. */
+static bool refused_options(const char *log, const probe_args *pa, l2p_error *err)
+{
+    static const char problem[] = "Problem with option setting";
+    size_t n = 0;
+    char *text = read_all(log, &n);
+    bool refused = false;
+    for (size_t i = 0; text && !refused && i + sizeof problem - 1 <= n; i++)
+        refused = !memcmp(text + i, problem, sizeof problem - 1);
+    free(text);
+    if (!refused)
+        return false;
+    char opts[600] = "";
+    for (int i = 0; i < pa->user_count; i++)
+        snprintf(opts + strlen(opts), sizeof opts - strlen(opts), "%s%s", i ? " " : "",
+                 pa->user[i]);
+    l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "-- %s: POV-Ray refuses these options (\"%s\", "
+             "\"Failed to parse command-line option\"; it does not say which)", opts, problem);
+    return true;
+}
+
+/* The copy, included by a file that first prints the frame POV-Ray is on. */
+static int write_probe_files(const char *work, const char *rewritten, char *copy, char *top,
+                             size_t cap, l2p_error *err)
+{
+    snprintf(copy, cap, "%s/scene-camera.pov", work);
+    snprintf(top, cap, "%s/scene-frame.pov", work);
+    char text[4400];
+    snprintf(text, sizeof text,
+             "#debug concat(\"lens2pov-frame \", str(frame_number, 0, 0), \" \", "
+             "str(final_frame, 0, 0), \" \", str(clock, 0, 17), \"|\\n\")\n"
+             "#include \"%s\"\n", copy);
+    int st = write_all(copy, rewritten, err);
+    return st ? st : write_all(top, text, err);
+}
+
+static int one_default_frame(const char *scene, scene_frames *out, l2p_error *err)
+{
+    out->frame = calloc(1, sizeof *out->frame);
+    if (!out->frame)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    out->count = 1;
+    return scene_camera_from_log("", 0, scene, &out->frame[0].cam, err);
+}
+
+static int probe(const char *scene, const char *dir, const char *work, int w, int h,
+                 const probe_args *pa, scene_frames *out, l2p_error *err)
+{
+    char copy[4200], top[4200], log[4200];
+    snprintf(log, sizeof log, "%s/scene-camera.log", work);
+    size_t n = 0;
+    char *text = read_all(scene, &n);
+    if (!text)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
+    char *rewritten = memchr(text, '\0', n) ? NULL : scene_camera_rewrite(text, n);
+    const bool no_camera = rewritten && !strcmp(rewritten, text);
+    free(text);
+    if (!rewritten)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file (or out of memory)");
+    if (no_camera && pa->user_count == 0) {   /* POV-Ray's default camera, one frame */
+        free(rewritten);
+        return one_default_frame(scene, out, err);
+    }
+    int st = write_probe_files(work, rewritten, copy, top, sizeof copy, err);
+    free(rewritten);
+    if (!st) {
+        st = run_probe(dir, top, log, w, h, pa, err);
+        if (st < 0 && pa->user_count && refused_options(log, pa, err))
+            st = L2P_BAD_INPUT;
+        if (st < 0) {   /* POV-Ray's own error, in the user's file */
+            const povray_path_link link = {copy, (char *)scene};
+            const povray_log_names names = {scene, dir, {top, NULL}, &link, 1};
+            if (!povray_log_error(log, &names, err))
+                l2p_fail(err, L2P_FAILED, scene, 0, "POV-Ray failed reading the scene's camera");
+            st = L2P_FAILED;
+        }
+    }
+    char *out_log = st ? NULL : read_all(log, &n);
+    if (!st && !out_log)
+        st = l2p_fail(err, L2P_FAILED, log, 0, "cannot read: %s", strerror(errno));
+    if (!st)
+        st = scene_frames_from_log(out_log, n, scene, out, err);
+    free(out_log);
+    unlink(copy);
+    unlink(top);
+    unlink(log);
+    return st;
+}
+
+int scene_frames_read(const char *scene, int width, int height, char *const *args,
+                      int arg_count, scene_frames *out, l2p_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (access(scene, R_OK) != 0)
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
+    const char *tmp = getenv("TMPDIR");
+    char work[4096];
+    snprintf(work, sizeof work, "%s/lens2pov-camera.XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    if (!plain_path(work))
+        snprintf(work, sizeof work, "/tmp/lens2pov-camera.XXXXXX");
+    if (!mkdtemp(work))
+        return l2p_fail(err, L2P_FAILED, work, 0, "cannot make a temporary folder: %s",
+                        strerror(errno));
+    cleanup_track(work);
+    char *dir = folder_of(scene);
+    const probe_args pa = {args, arg_count};
+    const int st = dir ? probe(scene, dir, work, width, height, &pa, out, err)
+                       : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    free(dir);
+    rmdir(work);
+    cleanup_untrack(work);
+    if (st)
+        scene_frames_free(out);
+    return st;
+}
+
+int scene_camera_read(const char *scene, int width, int height, scene_camera *out,
+                      l2p_error *err)
+{
+    scene_frames f;
+    const int st = scene_frames_read(scene, width, height, NULL, 0, &f, err);
+    if (!st)
+        *out = f.frame[f.count - 1].cam;
+    scene_frames_free(&f);
+    return st;
+}
+
+void scene_frames_free(scene_frames *f)
+{
+    free(f->frame);
+    memset(f, 0, sizeof *f);
+}

@@ -1,0 +1,275 @@
+/* POV-Ray's own options after "--" (issue 13): an animation gives one picture a frame, named
+   as POV-Ray names its frames, each through that frame's camera, with the lens traced once;
+   Declare= reaches the scene; image_width reads the film's width; options that would break
+   the ray table are refused before any work. Pictures are 48x36 at 4 samples a pixel. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+#include "image/image_io.h"
+#include "povray/povargs.h"
+#include "povray/scenecam.h"
+#include "support.h"
+
+#define DGAUSS LENS_DIR "dgauss.50mm.dat"
+#define L2P(out, errtext, ...) run_lens2pov(out, errtext, __VA_ARGS__, (char *)NULL)
+#define SIZE "--width", "48", "--height", "36", "--spp", "4"
+
+/* Markers (emitting spheres, one colour each) and a camera that moves with the clock. */
+#define ANIMATED_SCENE                                                                          \
+    "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"                                    \
+    "#macro Marker(P, C) sphere { P, 0.08 pigment { rgb C }\n"                                  \
+    "    finish { ambient 0 emission 1 diffuse 0 } } #end\n"                                   \
+    "Marker(<0, 0.5, 0>, <1, 0, 0>)\nMarker(<0.7, 0.5, 0.2>, <0, 1, 0>)\n"                     \
+    "Marker(<-0.3, 1, 0.4>, <0, 0, 1>)\n"                                                      \
+    "camera { location <clock - 0.5, 1, -4> look_at <clock - 0.5, 0.7, 0> angle 40\n"         \
+    "  right x * image_width / image_height }\n"
+
+typedef struct centroid { double x, y; bool found; } centroid;
+
+/* Where channel c dominates: the weighted centre, in pixels (0, 0 the top-left corner). */
+static centroid marker(const char *path, int c)
+{
+    int w, h;
+    float *p;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(path, &w, &h, &p, &err), 0, "%s: %s", path, err.text);
+    double sx = 0, sy = 0, s = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *q = p + 4 * ((size_t)y * (size_t)w + (size_t)x);
+            const double v = q[c], others = q[0] + q[1] + q[2] - q[c];
+            if (v > 0.05 && v > 2 * others) {
+                sx += v * (x + 0.5);
+                sy += v * (y + 0.5);
+                s += v;
+            }
+        }
+    free(p);
+    return (centroid){s > 0 ? sx / s : NAN, s > 0 ? sy / s : NAN, s > 0};
+}
+
+/* A path kept in the caller's buffer (tmp_path's rotate). */
+static const char *hold(char *buf, const char *dir, const char *name)
+{
+    snprintf(buf, 512, "%s/%s", dir, name);
+    return buf;
+}
+
+Test(animation, frames_named_as_povray_traced_once)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512], keep_buf[512];
+    const char *scene = hold(scene_buf, dir, "scene.pov"), *keep = hold(keep_buf, dir, "keep");
+    write_text(scene, ANIMATED_SCENE);
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "cd '%s' && povray +Iscene.pov +Oown.png +W48 +H36 +FN -A -D -V "
+             "-GA +KFI1 +KFF3 >povray.log 2>&1", dir);
+    cr_assert_eq(system(cmd), 0, "%s", cmd);
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--angle", "scene",
+                       "--jobs", "2", "-q", "--keep-temp", keep, "-o", tmp_path(dir, "lens.png"),
+                       "--", "+KFI1", "+KFF3");
+    cr_assert_eq(st, 0, "render failed: %s", errtext ? errtext : "");
+    free(errtext);
+    char listing[1024];
+    cr_expect_eq(count_entries(dir, "lens", listing, sizeof listing), 3, "%s", listing);
+    cr_expect_eq(count_entries(keep, "rays.map", NULL, 0), 1, "the lens was traced per frame");
+    cr_expect_eq(count_entries(keep, "rays.t", NULL, 0), 0, "a second table was traced");
+    for (int f = 1; f <= 3; f++) {
+        char own[32], lens[32];
+        snprintf(own, sizeof own, "own%d.png", f);
+        snprintf(lens, sizeof lens, "lens%d.png", f);
+        for (int c = 0; c < 3; c++) {
+            const centroid a = marker(tmp_path(dir, own), c), b = marker(tmp_path(dir, lens), c);
+            cr_assert(a.found && b.found, "frame %d marker %d missing (POV-Ray %d, lens %d)", f,
+                      c, a.found, b.found);
+            cr_expect(fabs(a.x - b.x) < 1.0 && fabs(a.y - b.y) < 1.0,
+                      "frame %d marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", f, c, a.x,
+                      a.y, b.x, b.y);
+        }
+    }
+}
+
+/* A table placed by a frame's transform gives the picture a table traced in place gives; the
+   animation's table in three chunks (each rendered for every frame), the single frame's in
+   one. */
+Test(animation, placed_table_matches_a_single_frame)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512];
+    const char *scene = hold(scene_buf, dir, "scene.pov");
+    write_text(scene, ANIMATED_SCENE);
+    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--jobs", "2", "--memory-mb",
+                     "0.5", "-q", "-o", tmp_path(dir, "anim.png"), "--", "+KFI0", "+KFF2"), 0);
+    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q", "-o",
+                     tmp_path(dir, "single.png"), "--", "+K1"), 0);
+    cr_assert(file_exists(tmp_path(dir, "anim2.png")) && file_exists(tmp_path(dir, "single.png")));
+    int w, h, w2, h2;
+    float *a, *b;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "anim2.png"), &w, &h, &a, &err), 0, "%s", err.text);
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "single.png"), &w2, &h2, &b, &err), 0, "%s", err.text);
+    cr_assert(w == w2 && h == h2);
+    double worst = 0;
+    for (size_t i = 0; i < (size_t)w * (size_t)h * 4; i++)
+        worst = fmax(worst, fabs(a[i] - b[i]));
+    cr_expect(worst <= 1.0 / 255.0, "the placed table differs by %g", worst);
+    free(a);
+    free(b);
+}
+
+/* Declare= reaches the scene, and image_width and image_height read the film's size. */
+Test(animation, declare_and_image_size_reach_the_scene)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512], keep_buf[512];
+    const char *scene = hold(scene_buf, dir, "scene.pov"), *keep = hold(keep_buf, dir, "keep");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                      "#debug concat(\"seen: \", str(Shade, 0, 2), \" \", str(image_width, 0, 0),"
+                      " \" \", str(image_height, 0, 0), \"\\n\")\n"
+                      "background { rgb Shade }\n");
+    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q",
+                     "--location", "0,0,0", "--look-at", "0,0,1", "--keep-temp", keep, "-o",
+                     tmp_path(dir, "out.exr"), "--", "Declare=Shade=0.25"), 0);
+    size_t n;
+    char *log = read_text(tmp_path(keep, "povray.c000.log"), &n);
+    cr_assert_not_null(log);
+    cr_expect(strstr(log, "seen: 0.25 48 36"), "%s", log);
+    free(log);
+    int w, h;
+    float *p;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "out.exr"), &w, &h, &p, &err), 0, "%s", err.text);
+    const float *centre = p + 4 * ((size_t)(h / 2) * (size_t)w + (size_t)(w / 2));
+    cr_expect(fabs(centre[0] - 0.25) < 0.02, "centre %g", centre[0]);
+    free(p);
+}
+
+/* Refused before any work, naming "--" and the option; nothing written. */
+Test(animation, table_breaking_options_are_refused)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512];
+    const char *scene = hold(scene_buf, dir, "scene.pov");
+    write_text(scene, ANIMATED_SCENE);
+    const char *bad[] = {"+W100", "-h50", "+A0.3", "Antialias=On", "+FN", "+Oother.png",
+                         "Output_File_Type=N", "+SR0.5", "End_Column=10", "width=5"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char *errtext = NULL;
+        const clock_t t0 = clock();
+        const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "-q", "-o",
+                           tmp_path(dir, "out.png"), "--", "+KFI1", "+KFF3", bad[i]);
+        cr_expect_eq(st, 2, "%s: exit %d", bad[i], st);
+        cr_expect(errtext && strstr(errtext, "--") && strstr(errtext, bad[i]), "%s: %s", bad[i],
+                  errtext ? errtext : "");
+        cr_expect((double)(clock() - t0) / CLOCKS_PER_SEC < 1.0);
+        free(errtext);
+    }
+    cr_expect_eq(count_entries(dir, "out", NULL, 0), 0, "an output was written");
+}
+
+/* A value POV-Ray cannot read: POV-Ray's own message, exit 2, nothing written. */
+Test(animation, bad_value_gives_povrays_message)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512];
+    const char *scene = hold(scene_buf, dir, "scene.pov");
+    write_text(scene, ANIMATED_SCENE);
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "-q", "-o",
+                       tmp_path(dir, "out.png"), "--", "+KFIx");
+    cr_expect_eq(st, 2);
+    cr_expect(errtext && strstr(errtext, "+KFIx") && strstr(errtext, "Problem with option"),
+              "%s", errtext ? errtext : "");
+    free(errtext);
+    cr_expect_eq(count_entries(dir, "out", NULL, 0), 0, "an output was written");
+}
+
+/* POV-Ray's naming rule: the frame number padded to the final frame's digits, before the
+   extension. */
+Test(animation, frame_names)
+{
+    char *a = povargs_frame_name("dir.x/out.png", 3, povargs_frame_digits(10));
+    char *b = povargs_frame_name("out", 7, povargs_frame_digits(9));
+    char *c = povargs_frame_name("a.b/c.exr", 12, povargs_frame_digits(100));
+    cr_expect_str_eq(a, "dir.x/out03.png");
+    cr_expect_str_eq(b, "out7");
+    cr_expect_str_eq(c, "a.b/c012.exr");
+    free(a);
+    free(b);
+    free(c);
+}
+
+/* Frames from POV-Ray's output: one camera each, between "lens2pov-frame" messages. */
+Test(animation, frames_from_log)
+{
+    const char *log = "lens2pov-frame 1 3 0.00000000000000000|\n"
+                      "lens2pov-camera 0 5|\nlens2pov-version 3.700|\n"
+                      "lens2pov-location 0 1 -4|\nlens2pov-end|\n"
+                      "lens2pov-frame 2 3 0.5|\n"
+                      "lens2pov-camera 0 5|\nlens2pov-version 3.700|\n"
+                      "lens2pov-location 2 1 -4|\nlens2pov-end|\n";
+    scene_frames f;
+    l2p_error err;
+    cr_assert_eq(scene_frames_from_log(log, strlen(log), "s.pov", &f, &err), 0, "%s", err.text);
+    cr_assert_eq(f.count, 2);
+    cr_expect(f.animated && f.final_frame == 3);
+    cr_expect(f.frame[0].number == 1 && f.frame[1].number == 2 && f.frame[1].clock == 0.5);
+    cr_expect(f.frame[0].cam.location.x == 0 && f.frame[1].cam.location.x == 2);
+    scene_frames_free(&f);
+}
+
+/* A focus that follows look_at from frame to frame needs a table a frame. */
+Test(animation, changing_focus_traces_again)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512], keep_buf[512];
+    const char *scene = hold(scene_buf, dir, "scene.pov"), *keep = hold(keep_buf, dir, "keep");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                      "camera { location <0, 1, -4> look_at <0, 1, clock * 3> }\n"
+                      "sphere { <0, 1, 0>, 0.5 pigment { rgb 1 } finish { emission 1 } }\n");
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q",
+                       "--keep-temp", keep, "-o", tmp_path(dir, "f.png"), "--", "+KFI1",
+                       "+KFF2");
+    cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+    free(errtext);
+    cr_expect_eq(count_entries(keep, "rays.map", NULL, 0), 1);
+    cr_expect_eq(count_entries(keep, "rays.t1.map", NULL, 0), 1);
+    cr_expect(file_exists(tmp_path(dir, "f1.png")) && file_exists(tmp_path(dir, "f2.png")));
+}
+
+/* An .ini (with the animation in it) and +L given relative to the current folder, while
+   POV-Ray runs in the scene's. */
+Test(animation, ini_and_library_path_relative_to_here)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512], sub[512], cwd[512], exe[1024];
+    const char *scene = hold(scene_buf, dir, "scene.pov");
+    hold(sub, dir, "sub");
+    cr_assert_eq(mkdir(sub, 0777), 0);
+    write_text(tmp_path(sub, "a.ini"), "Initial_Frame=1\nFinal_Frame=2\n");
+    write_text(tmp_path(sub, "lib.inc"), "#declare Shade = 0.5;\n");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n#include \"lib.inc\"\n"
+                      "camera { location <clock, 1, -4> look_at <clock, 1, 0> }\n"
+                      "background { rgb Shade }\n");
+    /* Each test runs in a process of its own: the folder can change. */
+    cr_assert_not_null(getcwd(cwd, sizeof cwd));
+    const char *given = getenv("LENS2POV");
+    snprintf(exe, sizeof exe, "%s", given && *given ? given : "build/lens2pov");
+    if (exe[0] != '/')
+        snprintf(exe, sizeof exe, "%s/%s", cwd, given && *given ? given : "build/lens2pov");
+    setenv("LENS2POV", exe, 1);
+    cr_assert_eq(chdir(sub), 0);
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q",
+                       "-o", tmp_path(dir, "r.png"), "--", "a.ini", "+L.");
+    cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+    free(errtext);
+    cr_expect(file_exists(tmp_path(dir, "r1.png")) && file_exists(tmp_path(dir, "r2.png")));
+}
