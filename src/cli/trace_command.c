@@ -7,6 +7,7 @@
 #include "base/outfile.h"
 #include "cli/framing.h"
 #include "cli/sizecheck.h"
+#include "raytable/chunk_ini.h"
 #include "raytable/povmesh.h"
 #include "raytable/raytable.h"
 
@@ -25,7 +26,7 @@ static int check_trace_outputs(const cli *c, l2p_error *err)
     }
     free(path);
     if (!st)
-        st = povmesh_check_prefix(c->output, err);
+        st = chunk_ini_check_prefix(c->output, err);
     if (!st && c->rays_csv)
         st = outfile_check_path(c->rays_csv, err);
     return st;

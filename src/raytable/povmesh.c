@@ -5,6 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "raytable/chunk_ini.h"
 #include "raytable/chunk_name.h"
 #include "raytable/facelist.h"
 #include "base/outfile.h"
@@ -173,56 +174,16 @@ static void put_camera(text_out *t, const povmesh_emitter *e)
         e->placement ? e->placement : "", e->placement ? " }" : "");
 }
 
-/* The render's name, absolute: POV-Ray is run in the scene's folder, not in ours. */
-static char *absolute_exr_path(const povmesh_emitter *e, int index)
-{
-    char *exr = chunk_path(e, index, "exr"), cwd[4096];
-    if (!exr || exr[0] == '/' || !getcwd(cwd, sizeof cwd))
-        return exr;
-    char *abs = malloc(strlen(cwd) + strlen(exr) + 2);
-    if (abs)
-        sprintf(abs, "%s/%s", cwd, exr);
-    free(exr);
-    return abs;
-}
-
-static int ini_cannot_carry(const char *path, l2p_error *err)
-{
-    return l2p_fail(err, L2P_BAD_INPUT, path, 0, "POV-Ray's .ini cannot name this file (it has "
-                    "a '\"', a control character or a byte beyond ASCII): choose another name");
-}
-
-int povmesh_check_prefix(const char *prefix, l2p_error *err)
-{
-    char cwd[4096];
-    const bool relative = prefix[0] != '/';
-    if (relative && !getcwd(cwd, sizeof cwd))
-        return L2P_OK;   /* absolute_exr_path keeps the name relative too */
-    char *abs = malloc((relative ? strlen(cwd) + 1 : 0) + strlen(prefix) + 1);
-    if (!abs)
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    sprintf(abs, "%s%s%s", relative ? cwd : "", relative ? "/" : "", prefix);
-    const int st = povray_ini_can_carry(abs) ? L2P_OK : ini_cannot_carry(abs, err);
-    free(abs);
-    return st;
-}
-
+/* The chunk's settings, naming its render by absolute path: POV-Ray runs in the scene's
+   folder, not in ours. */
 static int write_ini(povmesh_emitter *e, chunk *ch, int index, long long rows, l2p_error *err)
 {
-    char *path = chunk_path(e, index, "ini"), *exr = absolute_exr_path(e, index);
-    int st = !path || !exr ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
-             : !povray_ini_can_carry(exr) ? ini_cannot_carry(exr, err)
-                                          : outfile_open(&ch->ini, path, err);
-    if (!st)
-        fprintf(ch->ini.fp,
-                "; lens2pov: POV-Ray settings for the ray table beside this file.\n"
-                "; Row 0 of the image repeats row 1 (POV-Ray 3.7.0.10, FS#254): one row more.\n"
-                "Width=%d\nHeight=%lld\nAntialias=Off\nOutput_File_Type=E\nOutput_To_File=On\n"
-                "Output_File_Name=%s%s%s\nDisplay=Off\n", e->packed_width, rows + 1,
-                povray_ini_needs_quotes(exr) ? "\"" : "", exr, povray_ini_needs_quotes(exr) ? "\"" : "");
+    char *path = chunk_path(e, index, "ini"), *exr = chunk_path(e, index, "exr");
+    const int st = path && exr ? chunk_ini_write(&ch->ini, path, exr, e->packed_width, rows + 1, err)
+                               : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     free(path);
     free(exr);
-    return st ? st : outfile_finish(&ch->ini, err);
+    return st;
 }
 
 static int end_chunk(povmesh_emitter *e, int index, l2p_error *err)

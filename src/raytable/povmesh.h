@@ -73,9 +73,6 @@ void povmesh_set_chunk_hook(povmesh_emitter *e, povmesh_chunk_hook hook, void *c
 void povmesh_set_placement(povmesh_emitter *e, const char *transform_name);
 
 /* The name of a chunk's file: PREFIX.EXT, or PREFIX.cNNN.EXT when chunked (malloc'd). */
-/* Checks, before any work, that the .ini files of the table at prefix can name its renders
-   (absolute paths; povray_ini_can_carry): L2P_BAD_INPUT naming the path otherwise. */
-int povmesh_check_prefix(const char *prefix, l2p_error *err);
 
 char *povmesh_chunk_file(const char *prefix, bool chunked, int index, const char *ext);
 

@@ -1,0 +1,55 @@
+#include "raytable/chunk_ini.h"
+
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "povray/povray.h"
+
+/* path made absolute in the current folder (malloc'd); as it is when it cannot be. */
+static char *absolute(const char *path)
+{
+    char cwd[4096];
+    if (path[0] == '/' || !getcwd(cwd, sizeof cwd))
+        return strdup(path);
+    char *abs = malloc(strlen(cwd) + strlen(path) + 2);
+    if (abs)
+        sprintf(abs, "%s/%s", cwd, path);
+    return abs;
+}
+
+static int ini_cannot_carry(const char *path, l2p_error *err)
+{
+    return l2p_fail(err, L2P_BAD_INPUT, path, 0, "POV-Ray's .ini cannot name this file (it has "
+                    "a '\"', a control character or a byte beyond ASCII): choose another name");
+}
+
+int chunk_ini_check_prefix(const char *prefix, l2p_error *err)
+{
+    char *abs = absolute(prefix);
+    if (!abs)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    const int st = povray_ini_can_carry(abs) ? L2P_OK : ini_cannot_carry(abs, err);
+    free(abs);
+    return st;
+}
+
+int chunk_ini_write(outfile *ini, const char *ini_path, const char *exr_path, int width,
+                    long long height, l2p_error *err)
+{
+    char *exr = absolute(exr_path);
+    int st = !exr ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
+             : !povray_ini_can_carry(exr) ? ini_cannot_carry(exr, err)
+                                          : outfile_open(ini, ini_path, err);
+    if (!st) {
+        const char *quote = povray_ini_needs_quotes(exr) ? "\"" : "";
+        fprintf(ini->fp,
+                "; lens2pov: POV-Ray settings for the ray table beside this file.\n"
+                "; Row 0 of the image repeats row 1 (POV-Ray 3.7.0.10, FS#254): one row more.\n"
+                "Width=%d\nHeight=%lld\nAntialias=Off\nOutput_File_Type=E\nOutput_To_File=On\n"
+                "Output_File_Name=%s%s%s\nDisplay=Off\n", width, height, quote, exr, quote);
+    }
+    free(exr);
+    return st ? st : outfile_finish(ini, err);
+}

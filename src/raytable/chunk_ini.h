@@ -1,0 +1,18 @@
+/* A chunk's POV-Ray settings (.ini): the packed image's size, no antialiasing, and the EXR
+   render's name, absolute because POV-Ray runs in the scene's folder. */
+#ifndef LENS2POV_CHUNK_INI_H
+#define LENS2POV_CHUNK_INI_H
+
+#include "base/error.h"
+#include "base/outfile.h"
+
+/* Checks, before any work, that the .ini files of the table at prefix can name its renders
+   (absolute paths; povray_ini_can_carry): L2P_BAD_INPUT naming the path otherwise. */
+int chunk_ini_check_prefix(const char *prefix, l2p_error *err);
+
+/* Writes ini_path (through *ini, finished, not committed) for an image width x height
+   naming render exr_path (made absolute). */
+int chunk_ini_write(outfile *ini, const char *ini_path, const char *exr_path, int width,
+                    long long height, l2p_error *err);
+
+#endif
