@@ -253,6 +253,16 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
     }
     if (!st)
         st = setup_weights(c, o->weighting, err);
+    /* The blades last: a polygon inscribed in the opening passes a subset of the round stop's
+       rays, so the pupil fitted to the round stop covers every ray they pass (the fit assumes
+       a lens symmetric about its axis, which blades are not), and the normalized weights keep
+       the round opening's scale: blades darken the picture by the polygon's share of the
+       circle, as they do a real lens at the same f-number. */
+    if (!st && o->aperture_blades && o->trace == TRACE_KIND_THICK)
+        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--aperture-blades needs --trace full: thick-lens "
+                      "tracing passes every ray its sampled disk gives and has no stop to shape");
+    if (!st)
+        lens_set_blades(&c->lens, o->aperture_blades, o->blade_rotation_deg * (M_PI / 180.0));
     return st;
 }
 

@@ -21,6 +21,8 @@ typedef struct camera_options {
     double film_diagonal_mm;
     double film_distance_mm, focus_distance_units;  /* at most one; INFINITY focuses at infinity */
     double aperture_diameter_mm, f_number;          /* at most one */
+    int aperture_blades;                            /* 0: a round stop; else 3 .. LENS_MAX_BLADES */
+    double blade_rotation_deg;                      /* a corner's angle from +x toward +y */
     pupil_kind pupil;
     trace_kind trace;
     vec3 location, look_at, sky;

@@ -87,6 +87,11 @@ static const cli_option OPTIONS[] = {
     {"--aperture-diameter", NULL, CMD_CAMERA, false, true,
      "  --aperture-diameter MM | --f-number N   [the stop's full opening]\n"},
     {"--f-number", NULL, CMD_CAMERA, false, true, NULL},
+    {"--aperture-blades", NULL, CMD_CAMERA, false, true,
+     "  --aperture-blades N           straight blades, 3 to 32: a polygon inscribed in the\n"
+     "                                stop's opening [0: round]\n"},
+    {"--blade-rotation", NULL, CMD_CAMERA, false, true,
+     "  --blade-rotation DEG          a corner's angle from the lens's +x axis [0]\n"},
     {"--pupil", NULL, CMD_CAMERA, false, true,
      "  --pupil stop-image|rear|stop  [stop-image; stop is a biased diagnostic]\n"},
     {"--trace", NULL, CMD_CAMERA, false, true,
@@ -157,6 +162,15 @@ static int lens_option(cli *c, const char *opt, const char *v, l2p_error *err)
         return value_positive_double(opt, v, &o->aperture_diameter_mm, err);
     if (!strcmp(opt, "--f-number"))
         return value_positive_double(opt, v, &o->f_number, err);
+    if (!strcmp(opt, "--aperture-blades")) {
+        if (!value_int(v, &o->aperture_blades) || o->aperture_blades < 0 ||
+            (o->aperture_blades > 0 && o->aperture_blades < 3) ||
+            o->aperture_blades > LENS_MAX_BLADES)
+            return value_bad(err, opt, "0 (round) or a whole number from 3 to 32", v);
+        return L2P_OK;
+    }
+    if (!strcmp(opt, "--blade-rotation"))
+        return value_double_in(opt, v, -360.0, 360.0, &o->blade_rotation_deg, err);
     if (!strcmp(opt, "--pupil"))
         return pupil_kind_parse(v, &o->pupil) ? value_bad(err, opt, "stop, rear or stop-image", v) : 0;
     if (!strcmp(opt, "--trace")) {

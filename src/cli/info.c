@@ -115,6 +115,12 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, 
         n += (int)(sizeof more / sizeof more[0]);
         if (!json && !isfinite(f[n - 1].value))
             n--;   /* no image circle: the lens covers the film (JSON says null) */
+        /* N blades inscribed in the opening pass N sin(2 pi / N) / (2 pi) of its area: the
+           f-number of a round stop passing as much light. */
+        const int blades = c->lens.blades.count;
+        if (blades)
+            f[n++] = (field){"blades_f_number", "f-number of the blades' light", "",
+                             c->f_number / sqrt(blades * sin(2 * M_PI / blades) / (2 * M_PI))};
     }
     if (json) {
         fputs("{\n  \"lens\": \"", out);

@@ -481,3 +481,20 @@ double lens_sag_mm(const lens_surface *s, double rho_mm)
         root = 0.0;
     return -c_rho2 / (1.0 + sqrt(root));
 }
+
+/* Edge k joins the corners at rotation + 2 pi k / N and rotation + 2 pi (k + 1) / N: its
+   outward normal points halfway between them, at distance R cos(pi / N) from the centre. */
+void lens_set_blades(lens *l, int count, double rotation_rad)
+{
+    lens_blades *b = &l->blades;
+    memset(b, 0, sizeof *b);
+    if (count < 3 || count > LENS_MAX_BLADES)
+        return;
+    b->count = count;
+    b->apothem_ratio = cos(M_PI / count);
+    for (int k = 0; k < count; k++) {
+        const double angle = rotation_rad + (2 * k + 1) * M_PI / count;
+        b->normal_x[k] = cos(angle);
+        b->normal_y[k] = sin(angle);
+    }
+}

@@ -21,6 +21,16 @@ typedef struct lens_surface {
     int line;                /* line of the file that gave this row */
 } lens_surface;
 
+/* The stop's blades: a regular polygon of `count` corners inscribed in the stop's circle
+   (its corners on the circle of the current opening), or a round stop when count is 0. */
+enum { LENS_MAX_BLADES = 32 };
+typedef struct lens_blades {
+    int count;                          /* 0, or 3 .. LENS_MAX_BLADES */
+    double apothem_ratio;               /* cos(pi / count): an edge's distance over the radius */
+    double normal_x[LENS_MAX_BLADES];   /* each edge's outward unit normal */
+    double normal_y[LENS_MAX_BLADES];
+} lens_blades;
+
 typedef struct lens {
     char *path;              /* as given by the user, for messages */
     char *name;              /* file name without folders and without ".dat" */
@@ -29,6 +39,7 @@ typedef struct lens {
     int stop;                /* index of the aperture stop row */
     double stop_diameter_mm; /* current opening, at most surface[stop].aperture_mm */
     double film_distance_mm; /* rear vertex to film */
+    lens_blades blades;      /* the stop's shape (set by lens_set_blades; round at first) */
 } lens;
 
 /* Limits of lens_read and lens_parse, far above any real lens: they stop a wrong file (an
@@ -59,6 +70,16 @@ static inline double lens_ior_behind(const lens *l, int i) { return l->surface[i
 static inline double lens_semi_aperture_mm(const lens *l, int i)
 {
     return i == l->stop ? 0.5 * l->stop_diameter_mm : 0.5 * l->surface[i].aperture_mm;
+}
+
+/* Gives the stop `count` straight blades (0: round), one corner at rotation_rad from the +x
+   axis toward +y. */
+void lens_set_blades(lens *l, int count, double rotation_rad);
+
+/* The blades of surface i: the stop's when it has blades, else NULL (a round opening). */
+static inline const lens_blades *lens_blades_of(const lens *l, int i)
+{
+    return i == l->stop && l->blades.count ? &l->blades : NULL;
 }
 
 /* Front vertex to rear vertex: the sum of the thicknesses of rows 0 .. n-2. */

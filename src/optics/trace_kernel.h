@@ -130,16 +130,29 @@ INLINE unsigned settle(long long *status, unsigned alive, unsigned hit, unsigned
     return alive & ~failed;
 }
 
+/* Within the blades' polygon, inscribed in the opening of squared radius a2: a point is inside
+   when its projection on every edge's outward normal is at most the apothem, R cos(pi / N). */
+INLINE vmask within_blades(const lens_blades *b, real a2, vreal x, vreal y)
+{
+    vreal far = add(mul(x, splat(b->normal_x[0])), mul(y, splat(b->normal_y[0])));
+    for (int k = 1; k < b->count; k++)
+        far = vmax(far, add(mul(x, splat(b->normal_x[k])), mul(y, splat(b->normal_y[k]))));
+    return le(far, splat(sqrt(a2) * b->apothem_ratio));
+}
+
 /* One surface for the rays o, d of the lanes `alive`: the intersection, the clear aperture
-   (or the stop's opening) of squared radius a2, refraction with eta = n1 / n2 (none where
-   eta = 1). A ray that gets through moves to the surface with its new direction; one that
-   does not stays as it was and gets its status. Returns the lanes still alive. */
-INLINE unsigned cross(const lens_surface *s, real a2, real eta, vreal o[3], vreal d[3],
-                      long long *status, unsigned alive)
+   (or the stop's opening) of squared radius a2, and within it the blades' polygon when there
+   are blades, refraction with eta = n1 / n2 (none where eta = 1). A ray that gets through
+   moves to the surface with its new direction; one that does not stays as it was and gets its
+   status. Returns the lanes still alive. */
+INLINE unsigned cross(const lens_surface *s, real a2, const lens_blades *blades, real eta,
+                      vreal o[3], vreal d[3], long long *status, unsigned alive)
 {
     vreal h[3], e[3];
     const vmask hit = intersect(s, o, d, h);
-    const vmask inside = le(add(mul(h[0], h[0]), mul(h[1], h[1])), splat(a2));
+    vmask inside = le(add(mul(h[0], h[0]), mul(h[1], h[1])), splat(a2));
+    if (blades)
+        inside = mand(inside, within_blades(blades, a2, h[0], h[1]));
     unsigned tir = 0, grazing = 0;
     const bool refracts = eta != 1;
     if (refracts) {

@@ -31,7 +31,8 @@ LANES_ENTRY(const lens *l, trace_batch *b, int n)
             const int k = g * LANES;
             vreal o[3] = {load(b->ox + k), load(b->oy + k), load(b->oz + k)};
             vreal d[3] = {load(b->dx + k), load(b->dy + k), load(b->dz + k)};
-            alive[g] = cross(&l->surface[i], a * a, eta, o, d, b->status + k, alive[g]);
+            alive[g] = cross(&l->surface[i], a * a, lens_blades_of(l, i), eta, o, d, b->status + k,
+                             alive[g]);
             store(b->ox + k, o[0]);
             store(b->oy + k, o[1]);
             store(b->oz + k, o[2]);

@@ -86,8 +86,8 @@ static trace_status KNAME(through)(const lens *l, int first, int last, bool towa
     for (int i = toward_scene ? last : first; i >= first && i <= last; i += step) {
         const real front = lens_ior_front(l, i), behind = lens_ior_behind(l, i);
         const real a = lens_semi_aperture_mm(l, i);
-        if (!cross(&l->surface[i], a * a, toward_scene ? behind / front : front / behind, o, d,
-                   &status, 1)) {
+        if (!cross(&l->surface[i], a * a, lens_blades_of(l, i),
+                   toward_scene ? behind / front : front / behind, o, d, &status, 1)) {
             if (blocked_at)
                 *blocked_at = i;
             break;
