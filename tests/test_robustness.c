@@ -133,6 +133,12 @@ static const bad_line BAD_OPTIONS[] = {
     {{"render", "SCENE", DGAUSS, "--memory-mb", "1e300", "-o", "OUTEXR"}, "--memory-mb"},
     {{"render", "SCENE", DGAUSS, "-o", "OUT.jpg"}, "image type"},
     {{"render", "SCENE", DGAUSS, "--width", "0", "-o", "OUTEXR"}, "--width"},
+    /* blades */
+    {{"trace", DGAUSS, "--aperture-blades", "2", "-o", "OUT"}, "--aperture-blades"},
+    {{"trace", DGAUSS, "--aperture-blades", "33", "-o", "OUT"}, "--aperture-blades"},
+    {{"trace", DGAUSS, "--aperture-blades", "-1", "-o", "OUT"}, "--aperture-blades"},
+    {{"trace", DGAUSS, "--blade-rotation", "x", "-o", "OUT"}, "--blade-rotation"},
+    {{"trace", DGAUSS, "--aperture-blades", "6", "--trace", "thick", "-o", "OUT"}, "--trace full"},
     /* the command line itself */
     {{"trace", DGAUSS, "--frobnicate", "1", "-o", "OUT"}, "--frobnicate"},
     {{"trace", DGAUSS, "-o"}, "-o"},
