@@ -31,6 +31,14 @@ static double median5(double v[5])
     return v[2];
 }
 
+static double median3(double v[3])
+{
+    qsort(v, 3, sizeof v[0], by_value);
+    return v[1];
+}
+
+static int blades_for_bench;   /* the next camera's aperture blades (0: round) */
+
 static int make_camera(camera *c, const char *lens_path, pupil_kind p, trace_kind t, int w, int h, int spp)
 {
     lens l;
@@ -43,6 +51,7 @@ static int make_camera(camera *c, const char *lens_path, pupil_kind p, trace_kin
     o.pupil = p;
     o.trace = t;
     o.look_at = v3(0, 0, 10);
+    o.aperture_blades = blades_for_bench;
     if (lens_read(lens_path, &l, &err) || camera_setup(c, &l, &o, &err)) {
         fprintf(stderr, "bench: %s\n", err.text);
         return 1;
@@ -51,11 +60,11 @@ static int make_camera(camera *c, const char *lens_path, pupil_kind p, trace_kin
 }
 
 /* Samples of a 256 x 192 film at 16 spp: everything a film sample costs but the writing. */
-static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
+static double bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
 {
     camera c;
     if (make_camera(&c, lens_path, p, t, 256, 192, 16))
-        return;
+        return NAN;
     double rate[5], passed_fraction = 0;
     sample_batch batch;
     for (int run = 0; run < 5; run++) {
@@ -90,6 +99,7 @@ static void bench_trace(const char *lens_path, pupil_kind p, trace_kind t)
            pupil_kind_name(p), t == TRACE_KIND_THICK ? "thick" : "full", median5(rate) / 1e6,
            100 * passed_fraction);
     camera_free(&c);
+    return median5(rate);
 }
 
 /* The share of samples that pass, over a 35 mm film of 4:3 and at its centre, for the
@@ -230,6 +240,27 @@ int main(int argc, char **argv)
         const double f_numbers[] = {NAN, 8.0, 16.0};
         for (int f = 0; f < 3; f++)
             bench_pupil(path, f_numbers[f]);
+    }
+    printf("== blades: samples a second through a round stop and through 6 and 9 blades, "
+           "alternating (dgauss.50mm, stop-image pupil)\n");
+    {
+        char path[512];
+        snprintf(path, sizeof path, "%s/dgauss.50mm.dat", argv[1]);
+        const int counts[] = {0, 6, 9};
+        double rates[3][3];
+        for (int run = 0; run < 3; run++)
+            for (int k = 0; k < 3; k++) {
+                blades_for_bench = counts[k];
+                printf("%2d blades  ", counts[k]);
+                rates[k][run] = bench_trace(path, PUPIL_STOP_IMAGE, TRACE_KIND_FULL);
+            }
+        blades_for_bench = 0;
+        for (int k = 1; k < 3; k++) {
+            double a[3] = {rates[0][0], rates[0][1], rates[0][2]};
+            double b[3] = {rates[k][0], rates[k][1], rates[k][2]};
+            printf("%d blades: a sample costs %.3f times a round stop's (medians of 3 runs)\n",
+                   counts[k], median3(a) / median3(b));
+        }
     }
     printf("== writing the ray table (dgauss.50mm, 1024x1024, 1 spp)\n");
     char path[512];
