@@ -18,6 +18,7 @@
 #include "base/outfile.h"
 #include "povray/povray_log.h"
 
+/* The whole file, NUL-terminated (malloc'd); *n its length. */
 static char *read_all(const char *path, size_t *n)
 {
     FILE *f = fopen(path, "rb");
@@ -33,8 +34,10 @@ static char *read_all(const char *path, size_t *n)
         buf = grown;
     }
     fclose(f);
-    if (buf)
+    if (buf) {   /* len < cap: the loop grows the buffer when it is full */
+        buf[len] = '\0';
         *n = len;
+    }
     return buf;
 }
 
