@@ -2,12 +2,14 @@
 #define _XOPEN_SOURCE 700
 
 #include "support.h"
+#include "image/image_io.h"
 
 #include <criterion/criterion.h>
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <ftw.h>
+#include <math.h>
 #include <spawn.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -327,4 +329,25 @@ pov_ray *read_include_as_povray(const char *path, size_t *count)
     free(text);
     *count = (size_t)nf;
     return r;
+}
+
+marker_centroid image_marker(const char *path, int c)
+{
+    int w, h;
+    float *p;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(path, &w, &h, &p, &err), 0, "%s: %s", path, err.text);
+    double sx = 0, sy = 0, s = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *q = p + 4 * ((size_t)y * (size_t)w + (size_t)x);
+            const double v = q[c], others = q[0] + q[1] + q[2] - q[c];
+            if (v > 0.05 && v > 2 * others) {
+                sx += v * (x + 0.5);
+                sy += v * (y + 0.5);
+                s += v;
+            }
+        }
+    free(p);
+    return (marker_centroid){s > 0 ? sx / s : NAN, s > 0 ? sy / s : NAN, s > 0};
 }

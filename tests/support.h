@@ -58,4 +58,9 @@ csv_ray *read_rays_csv(const char *path, size_t *count);
 typedef struct pov_ray { vec3 o, d; } pov_ray;
 pov_ray *read_include_as_povray(const char *path, size_t *count);
 
+/* Where channel c of an image dominates (above 0.05 and twice the other two together): the
+   weighted centre in pixels, (0, 0) the top-left corner; found false when nowhere. */
+typedef struct marker_centroid { double x, y; bool found; } marker_centroid;
+marker_centroid image_marker(const char *path, int c);
+
 #endif

@@ -29,30 +29,6 @@
     "camera { location <clock - 0.5, 1, -4> look_at <clock - 0.5, 0.7, 0> angle 40\n"         \
     "  right x * image_width / image_height }\n"
 
-typedef struct centroid { double x, y; bool found; } centroid;
-
-/* Where channel c dominates: the weighted centre, in pixels (0, 0 the top-left corner). */
-static centroid marker(const char *path, int c)
-{
-    int w, h;
-    float *p;
-    l2p_error err;
-    cr_assert_eq(image_read_rgba(path, &w, &h, &p, &err), 0, "%s: %s", path, err.text);
-    double sx = 0, sy = 0, s = 0;
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            const float *q = p + 4 * ((size_t)y * (size_t)w + (size_t)x);
-            const double v = q[c], others = q[0] + q[1] + q[2] - q[c];
-            if (v > 0.05 && v > 2 * others) {
-                sx += v * (x + 0.5);
-                sy += v * (y + 0.5);
-                s += v;
-            }
-        }
-    free(p);
-    return (centroid){s > 0 ? sx / s : NAN, s > 0 ? sy / s : NAN, s > 0};
-}
-
 /* A path kept in the caller's buffer (tmp_path's rotate). */
 static const char *hold(char *buf, const char *dir, const char *name)
 {
@@ -85,7 +61,8 @@ Test(animation, frames_named_as_povray_traced_once)
         snprintf(own, sizeof own, "own%d.png", f);
         snprintf(lens, sizeof lens, "lens%d.png", f);
         for (int c = 0; c < 3; c++) {
-            const centroid a = marker(tmp_path(dir, own), c), b = marker(tmp_path(dir, lens), c);
+            const marker_centroid a = image_marker(tmp_path(dir, own), c),
+                                  b = image_marker(tmp_path(dir, lens), c);
             cr_assert(a.found && b.found, "frame %d marker %d missing (POV-Ray %d, lens %d)", f,
                       c, a.found, b.found);
             cr_expect(fabs(a.x - b.x) < 1.0 && fabs(a.y - b.y) < 1.0,

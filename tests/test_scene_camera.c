@@ -31,30 +31,6 @@
     "camera {\n  location Lift(Eye) // where it stands\n  look_at Target\n  angle 40\n"        \
     "  right " right " * image_width / image_height\n}\n"
 
-typedef struct centroid { double x, y; bool found; } centroid;
-
-/* Where channel c dominates: the weighted centre, in pixels (0, 0 the top-left corner). */
-static centroid marker(const char *path, int c)
-{
-    int w, h;
-    float *p;
-    l2p_error err;
-    cr_assert_eq(image_read_rgba(path, &w, &h, &p, &err), 0, "%s: %s", path, err.text);
-    double sx = 0, sy = 0, s = 0;
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            const float *q = p + 4 * ((size_t)y * (size_t)w + (size_t)x);
-            const double v = q[c], others = q[0] + q[1] + q[2] - q[c];
-            if (v > 0.05 && v > 2 * others) {
-                sx += v * (x + 0.5);
-                sy += v * (y + 0.5);
-                s += v;
-            }
-        }
-    free(p);
-    return (centroid){s > 0 ? sx / s : NAN, s > 0 ? sy / s : NAN, s > 0};
-}
-
 static void povray_render(const char *dir, const char *scene, const char *out)
 {
     char cmd[1024];
@@ -80,7 +56,7 @@ static void expect_markers_as_povray(const char *scene_text)
     cr_assert_eq(st, 0, "render failed: %s", errtext ? errtext : "");
     free(errtext);
     for (int c = 0; c < 3; c++) {
-        const centroid a = marker(own, c), b = marker(lens, c);
+        const marker_centroid a = image_marker(own, c), b = image_marker(lens, c);
         cr_assert(a.found && b.found, "marker %d missing (POV-Ray %d, lens %d)", c, a.found, b.found);
         cr_log_info("marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", c, a.x, a.y, b.x, b.y);
         /* The lens has a little distortion and depth of field; a pixel is the tolerance. */
