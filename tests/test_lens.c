@@ -391,13 +391,15 @@ Test(lens, four_columns_have_no_abbe_numbers)
 Test(lens, abbe_number_on_air_must_be_zero)
 {
     REFUSED(FRONT_V "0 1 0 4 3\n" REAR, 2, "Abbe number must be 0 on an air row (index 0), got 3");
-    REFUSED(FRONT_V STOP "-10 5 1 8 30\n", 3, "Abbe number must be 0 on an air row (index 1), got 30");
+    REFUSED(FRONT_V STOP "-10 5 1 8 30\n", 3,
+            "Abbe number must be 0 on an air row (index 1), got 30");
     REFUSED(FRONT STOP "-10 5 1 8 -1\n", 3, "must be 0 on an air row");
 }
 
 Test(lens, abbe_number_of_glass_must_be_positive)
 {
-    REFUSED("10 2 1.5 8 0\n" STOP REAR, 1, "Abbe number of the glass behind the surface must be positive, got 0");
+    REFUSED("10 2 1.5 8 0\n" STOP REAR, 1,
+            "Abbe number of the glass behind the surface must be positive, got 0");
     REFUSED("10 2 1.5 8 -64\n" STOP REAR, 1, "must be positive, got -64");
     REFUSED("10 2 1.5 8 nan\n" STOP REAR, 1, "not a finite number: 'nan'");
     REFUSED("10 2 1.5 8 inf\n" STOP REAR, 1, "not a finite number: 'inf'");

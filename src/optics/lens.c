@@ -525,11 +525,12 @@ double lens_total_length_mm(const lens *l)
     return length;
 }
 
-/* The two-term Cauchy fit n(lambda) = A + B / lambda^2 through n_d with the Abbe number's
-   principal dispersion n_F - n_C = (n_d - 1) / V_d:
-     n_F - n_C = B (1/lambda_F^2 - 1/lambda_C^2)  gives  B = (n_d - 1) / (V_d (1/lambda_F^2 - 1/lambda_C^2)),
-     n(lambda_d) = n_d                              gives  A = n_d - B / lambda_d^2.
-   (Cauchy's formula; the Abbe number as in Smith, Modern Optical Engineering, ch. 7.) */
+/* The two-term Cauchy fit n(lambda) = A + B / lambda^2 through n_d with the principal
+   dispersion the Abbe number defines, V_d = (n_d - 1) / (n_F - n_C):
+     n_F - n_C = B (1/lambda_F^2 - 1/lambda_C^2) = (n_d - 1) / V_d
+         gives B = (n_d - 1) / (V_d (1/lambda_F^2 - 1/lambda_C^2)),
+     n(lambda_d) = n_d
+         gives A = n_d - B / lambda_d^2. */
 double lens_index_at(const lens_surface *s, double wavelength_nm)
 {
     if (s->abbe == 0.0)

@@ -4,8 +4,9 @@
    radius (positive: centre of curvature on the film side; 0: the aperture stop),
    thickness to the next surface, index of refraction behind the surface (n_d; 0 on the stop
    row means air), clear aperture diameter, and optionally the Abbe number V_d of the medium
-   behind the surface (0 or absent for air; every glass row gives one or none does). Camera space puts the film at z = 0 and the lens toward
-   +z; surface i has its vertex at z = film_distance + sum of thicknesses of rows i .. n-2. */
+   behind the surface (0 or absent for air; every glass row gives one or none does). Camera
+   space puts the film at z = 0 and the lens toward +z; surface i has its vertex at
+   z = film_distance + sum of thicknesses of rows i .. n-2. */
 #ifndef LENS2POV_LENS_H
 #define LENS2POV_LENS_H
 
@@ -64,7 +65,8 @@ static inline double lens_semi_aperture_mm(const lens *l, int i)
 }
 
 /* Index of the medium behind surface s at this wavelength (nm): ior where the file gives no
-   Abbe number, else the Cauchy fit A + B / lambda^2 through n_d and V_d (lens.c, docs/lenses.md). */
+   Abbe number, else the Cauchy fit A + B / lambda^2 through n_d and V_d (lens.c,
+   docs/lenses.md). */
 double lens_index_at(const lens_surface *s, double wavelength_nm);
 
 /* 1 when the file gave Abbe numbers (its glass rows have a fifth column), else 0. */
