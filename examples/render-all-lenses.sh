@@ -122,7 +122,7 @@ done
 # The contact sheet: a label column, a header row, and one 320x240 tile per render (fitted and
 # padded, so that any image size or aspect fits). oiiotool's --paste puts the image *below* the
 # top of the stack onto the top one, hence the --swap after each tile.
-tile_w=320 tile_h=240 gap=6 label_w=190 head_h=34
+tile_w=320 tile_h=240 gap=6 label_w=230 head_h=34
 sheet_w=$((label_w + 3 * (tile_w + gap)))
 sheet_h=$((head_h + lenses * (tile_h + gap)))
 text="--text:size=18:color=0.95,0.95,0.95:font=$font"

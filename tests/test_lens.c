@@ -87,14 +87,15 @@ Test(lens, three_numbers)
     REFUSED("5\n" FRONT STOP, 1, "got 1");
 }
 
-Test(lens, five_numbers)
+Test(lens, six_numbers)
 {
-    REFUSED(FRONT "20 2 1.5 8 5\n" STOP, 2, "unexpected '5' after the 4 numbers");
+    REFUSED(FRONT "20 2 1.5 8 5 6\n" STOP, 2, "unexpected '6' after the 5 numbers");
 }
 
 Test(lens, text_after_numbers)
 {
-    REFUSED(FRONT STOP "-10 5 1 8 x\n", 3, "unexpected 'x' after the 4 numbers");
+    REFUSED(FRONT STOP "-10 5 1 8 0 x\n", 3, "unexpected 'x' after the 5 numbers");
+    REFUSED(FRONT STOP "-10 5 1 8 x\n", 3, "not a number: 'x'");
     REFUSED(FRONT STOP "-10 5 1 8x\n", 3, "not a number: '8x'");
 }
 
@@ -352,6 +353,102 @@ Test(lens, blank_lines_and_line_numbers)
     lens_free(&l);
 }
 
+/* ---- the fifth column: Abbe numbers --------------------------------------------------- */
+
+/* FRONT, STOP and REAR with Abbe numbers: the glass's, and 0 on the air rows. */
+#define FRONT_V "10 2 1.5 8 64.2\n"
+#define STOP_V "0 1 0 4 0\n"
+#define REAR_V "-10 5 1 8 0\n"
+
+Test(lens, abbe_numbers_are_read)
+{
+    lens l = parsed(FRONT_V STOP REAR);
+    expect_minimal(&l);
+    cr_assert_eq(l.surface[0].abbe, 64.2);
+    cr_assert_eq(l.surface[1].abbe, 0.0);
+    cr_assert_eq(l.surface[2].abbe, 0.0);
+    cr_assert_eq(lens_has_abbe(&l), 1);
+    lens_free(&l);
+    l = parsed(FRONT_V STOP_V REAR_V);
+    expect_minimal(&l);
+    cr_assert_eq(l.surface[0].abbe, 64.2);
+    lens_free(&l);
+}
+
+Test(lens, four_columns_have_no_abbe_numbers)
+{
+    lens l = parsed(FRONT STOP REAR);
+    cr_assert_eq(lens_has_abbe(&l), 0);
+    for (int i = 0; i < l.count; i++) {
+        cr_assert_eq(l.surface[i].abbe, 0.0);
+        /* Without an Abbe number the index is the same at every wavelength. */
+        cr_assert_eq(lens_index_at(&l.surface[i], 400.0), l.surface[i].ior);
+        cr_assert_eq(lens_index_at(&l.surface[i], 700.0), l.surface[i].ior);
+    }
+    lens_free(&l);
+}
+
+Test(lens, abbe_number_on_air_must_be_zero)
+{
+    REFUSED(FRONT_V "0 1 0 4 3\n" REAR, 2, "Abbe number must be 0 on an air row (index 0), got 3");
+    REFUSED(FRONT_V STOP "-10 5 1 8 30\n", 3,
+            "Abbe number must be 0 on an air row (index 1), got 30");
+    REFUSED(FRONT STOP "-10 5 1 8 -1\n", 3, "must be 0 on an air row");
+}
+
+Test(lens, abbe_number_of_glass_must_be_positive)
+{
+    REFUSED("10 2 1.5 8 0\n" STOP REAR, 1,
+            "Abbe number of the glass behind the surface must be positive, got 0");
+    REFUSED("10 2 1.5 8 -64\n" STOP REAR, 1, "must be positive, got -64");
+    REFUSED("10 2 1.5 8 nan\n" STOP REAR, 1, "not a finite number: 'nan'");
+    REFUSED("10 2 1.5 8 inf\n" STOP REAR, 1, "not a finite number: 'inf'");
+    REFUSED("10 2 1.5 8 1e999\n" STOP REAR, 1, "out of range");
+}
+
+Test(lens, abbe_numbers_on_every_glass_row_or_none)
+{
+    REFUSED(FRONT STOP "-10 2 1.6 8 30\n-20 5 1 8\n", 3,
+            "Abbe number on this glass row, but none on the glass row of line 1");
+    REFUSED(FRONT_V STOP "-10 2 1.6 8\n-20 5 1 8\n", 3,
+            "no Abbe number on this glass row, but the glass row of line 1 has one");
+    /* Air rows may give 0 or nothing, whatever the glass rows do. */
+    lens l = parsed(FRONT STOP_V REAR_V);
+    cr_assert_eq(lens_has_abbe(&l), 0);
+    lens_free(&l);
+    l = parsed(FRONT_V STOP "-10 2 1.6 8 30\n-20 5 1 8 0\n");
+    cr_assert_eq(l.surface[2].abbe, 30.0);
+    lens_free(&l);
+}
+
+Test(lens, stop_in_glass_takes_an_abbe_number)
+{
+    lens l = parsed(FRONT_V "0 1 1.5 4 64.2\n" REAR);
+    cr_assert_eq(l.surface[1].abbe, 64.2);
+    lens_free(&l);
+    REFUSED(FRONT_V "0 1 1.5 4\n" REAR, 2, "no Abbe number on this glass row");
+}
+
+/* The Cauchy fit: n_d at the d line, n_F - n_C = (n_d - 1) / V_d, falling with wavelength. */
+Test(lens, index_at_wavelength_is_the_cauchy_fit)
+{
+    const lens_surface s = {.ior = 1.5168, .abbe = 64.17};
+    cr_assert_float_eq(lens_index_at(&s, 587.5618), 1.5168, 1e-15);
+    const double nf = lens_index_at(&s, 486.1327), nc = lens_index_at(&s, 656.2725);
+    cr_assert_float_eq(nf - nc, 0.5168 / 64.17, 1e-15);
+    cr_assert_gt(lens_index_at(&s, 400.0), nf);
+    cr_assert_lt(lens_index_at(&s, 700.0), nc);
+    /* By hand: B = 0.5168 / (64.17 (1/486.1327^2 - 1/656.2725^2)) nm^2,
+       A = 1.5168 - B / 587.5618^2, n(450 nm) = A + B / 450^2. */
+    const double b = 0.5168 / (64.17 * (1 / (486.1327 * 486.1327) - 1 / (656.2725 * 656.2725)));
+    const double a = 1.5168 - b / (587.5618 * 587.5618);
+    cr_assert_float_eq(lens_index_at(&s, 450.0), a + b / (450.0 * 450.0), 1e-15);
+    cr_assert_float_eq(b, 4217.377, 0.001, "B = %.6f nm^2", b);
+    /* N-BK7 (n_d 1.5168, V_d 64.17) in Schott's catalogue: n_F 1.52238, n_C 1.51432. */
+    cr_assert_float_eq(nf, 1.52238, 1e-4, "n_F %.6f", nf);
+    cr_assert_float_eq(nc, 1.51432, 1e-4, "n_C %.6f", nc);
+}
+
 Test(lens, byte_order_mark)
 {
     lens l = parsed("\xEF\xBB\xBF" FRONT STOP REAR);
@@ -447,14 +544,14 @@ Test(lens, read_mkstemp_file_with_error)
     char path[] = "/tmp/lens_test_XXXXXX";
     int fd = mkstemp(path);
     cr_assert(fd >= 0, "mkstemp: %s", strerror(errno));
-    const char text[] = FRONT "\n" STOP "-10 5 1 8 9\n";
+    const char text[] = FRONT "\n" STOP "-10 5 1 8 0 9\n";
     cr_assert_eq(write(fd, text, sizeof text - 1), (ssize_t)(sizeof text - 1));
     close(fd);
     lens l;
     l2p_error err = {0};
     cr_assert_eq(lens_read(path, &l, &err), L2P_BAD_INPUT);
     char expected[128];
-    snprintf(expected, sizeof expected, "%s:4: unexpected '9' after the 4 numbers", path);
+    snprintf(expected, sizeof expected, "%s:4: unexpected '9' after the 5 numbers", path);
     cr_assert_str_eq(err.text, expected);
     cr_assert_null(l.surface);
     unlink(path);

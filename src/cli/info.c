@@ -127,10 +127,13 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, 
         for (const char *p = l->name; *p; p++)
             fprintf(out, *p == '"' || *p == '\\' ? "\\%c" : (unsigned char)*p < 32 ? "\\u%04x" : "%c", *p);
         fputs("\",\n", out);
+        /* Only for files that give Abbe numbers: a four-column file prints as it always did. */
+        if (lens_has_abbe(l))
+            fputs("  \"abbe_numbers\": true,\n", out);
     }
     else
-        fprintf(out, "%s (%d surfaces, stop on line %d)\n", l->path, l->count,
-                l->surface[l->stop].line);
+        fprintf(out, "%s (%d surfaces, stop on line %d%s)\n", l->path, l->count,
+                l->surface[l->stop].line, lens_has_abbe(l) ? ", Abbe numbers given" : "");
     print_fields(out, f, n, json);
     if (json)
         fprintf(out, "}\n");

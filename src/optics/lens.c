@@ -1,7 +1,8 @@
 /* Reading, validating and querying a lens prescription (pbrt's format, see lens.h).
 
-   Users bring their own files, so the reader is strict: every row is exactly four decimal
-   numbers, everything else is an error that names the file and the line. */
+   Users bring their own files, so the reader is strict: every row is four decimal numbers, or
+   five with the Abbe number of the glass behind the surface, and every glass row of a file gives
+   one or none does; everything else is an error that names the file and the line. */
 #include "optics/lens.h"
 
 #include <errno.h>
@@ -23,16 +24,25 @@ enum { QUOTE_MAX_CHARS = 32 };
 /* One row as read: the numbers, and their text as written, which messages quote so that the
    user sees the number they typed rather than a reformatting of it. */
 typedef struct row {
-    double value[4];
-    const char *text[4];
-    int text_length[4];
+    double value[5];
+    const char *text[5];
+    int text_length[5];
+    int count;               /* 4, or 5 with an Abbe number */
 } row;
 
-/* Where the parser is, for messages. */
+/* Standard wavelengths of the Abbe number, nm: helium d, hydrogen F and C lines. */
+#define WAVELENGTH_D_NM 587.5618
+#define WAVELENGTH_F_NM 486.1327
+#define WAVELENGTH_C_NM 656.2725
+
+/* Where the parser is, for messages; and the first glass row, which says whether the file
+   gives Abbe numbers (0 before any glass row). */
 typedef struct where {
     const char *path;
     int line;
     l2p_error *err;
+    int first_glass_line;
+    int first_glass_has_abbe;
 } where;
 
 /* The separators between numbers. '\r' is one so that CRLF files read like LF files. */
@@ -88,7 +98,7 @@ static int parse_number(const where *w, const char *token, size_t length, double
 }
 
 /* Splits one line (without its '\n') into a row. *found is 0 for a blank or comment-only
-   line, 1 for a row of four numbers; anything else is an error. */
+   line, 1 for a row of four or five numbers; anything else is an error. */
 static int parse_line(const where *w, const char *p, const char *eol, row *r, int *found)
 {
     *found = 0;
@@ -112,9 +122,9 @@ static int parse_line(const where *w, const char *p, const char *eol, row *r, in
         int st = check_printable(w, token, length);
         if (st)
             return st;
-        if (n == 4)
+        if (n == 5)
             return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
-                            "unexpected '%.*s%s' after the 4 numbers",
+                            "unexpected '%.*s%s' after the 5 numbers",
                             length > QUOTE_MAX_CHARS ? QUOTE_MAX_CHARS : (int)length, token,
                             length > QUOTE_MAX_CHARS ? "..." : "");
         st = parse_number(w, token, length, &r->value[n]);
@@ -124,11 +134,12 @@ static int parse_line(const where *w, const char *p, const char *eol, row *r, in
         r->text_length[n] = (int)length;   /* at most NUMBER_MAX_CHARS */
         n++;
     }
-    if (n != 0 && n != 4)
+    if (n != 0 && n != 4 && n != 5)
         return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
                         "expected 4 numbers (radius, thickness, index of refraction, "
-                        "aperture diameter), got %d", n);
-    *found = n == 4;
+                        "aperture diameter) or 5 (and the Abbe number), got %d", n);
+    r->count = n;
+    *found = n != 0;
     return L2P_OK;
 }
 
@@ -164,6 +175,52 @@ static int check_row(const where *w, const row *r)
     return L2P_OK;
 }
 
+/* Air behind the surface: index 1, or the stop row's 0. */
+static int row_is_air(const row *r)
+{
+    return r->value[2] == 1.0 || (r->value[0] == 0.0 && r->value[2] == 0.0);
+}
+
+/* The Abbe number of one row, on its own: 0 on air (like the index column's 0 on the stop),
+   positive behind glass. Not finite was refused with the number. */
+static int check_abbe(const where *w, const row *r)
+{
+    if (r->count < 5)
+        return L2P_OK;
+    const double abbe = r->value[4];
+    if (row_is_air(r) && abbe != 0.0)
+        return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
+                        "Abbe number must be 0 on an air row (index %.*s), got %.*s",
+                        r->text_length[2], r->text[2], r->text_length[4], r->text[4]);
+    if (!row_is_air(r) && !(abbe > 0.0))
+        return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
+                        "Abbe number of the glass behind the surface must be positive, got %.*s",
+                        r->text_length[4], r->text[4]);
+    return L2P_OK;
+}
+
+/* Every glass row gives an Abbe number or none does: a file that gives some only would trace
+   those glasses with dispersion and the others without. Air rows may give 0 or nothing. */
+static int check_abbe_column(where *w, const row *r)
+{
+    if (row_is_air(r))
+        return L2P_OK;
+    const int has = r->count == 5;
+    if (w->first_glass_line == 0) {
+        w->first_glass_line = w->line;
+        w->first_glass_has_abbe = has;
+        return L2P_OK;
+    }
+    if (has == w->first_glass_has_abbe)
+        return L2P_OK;
+    return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
+                    has ? "Abbe number on this glass row, but none on the glass row of line %d "
+                          "(give every glass row one, or none)"
+                        : "no Abbe number on this glass row, but the glass row of line %d has "
+                          "one (give every glass row one, or none)",
+                    w->first_glass_line);
+}
+
 static int out_of_memory(l2p_error *err)
 {
     return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
@@ -191,6 +248,7 @@ static int append_surface(const where *w, lens *l, int *capacity, const row *r)
         .thickness_mm = r->value[1],
         .ior = radius == 0.0 && r->value[2] == 0.0 ? 1.0 : r->value[2],
         .aperture_mm = r->value[3],
+        .abbe = r->count == 5 ? r->value[4] : 0.0,
         .vertex_z_mm = 0.0,
         .line = w->line,
     };
@@ -218,7 +276,7 @@ static int parse_rows(const char *text, size_t length, const char *path, lens *l
     /* Editors on Windows may start a UTF-8 file with a byte order mark. */
     if (length >= 3 && memcmp(p, "\xEF\xBB\xBF", 3) == 0)
         p += 3;
-    where w = {path, 0, err};
+    where w = {path, 0, err, 0, 0};
     int capacity = 0;
     while (p < end) {
         w.line++;
@@ -230,6 +288,10 @@ static int parse_rows(const char *text, size_t length, const char *path, lens *l
         int st = parse_line(&w, p, eol, &r, &found);
         if (!st && found)
             st = check_row(&w, &r);
+        if (!st && found)
+            st = check_abbe(&w, &r);
+        if (!st && found)
+            st = check_abbe_column(&w, &r);
         if (!st && found && r.value[0] == 0.0)
             st = note_stop(&w, l);
         if (!st && found)
@@ -461,6 +523,31 @@ double lens_total_length_mm(const lens *l)
     for (int i = 0; i < l->count - 1; i++)
         length += l->surface[i].thickness_mm;
     return length;
+}
+
+/* The two-term Cauchy fit n(lambda) = A + B / lambda^2 through n_d with the principal
+   dispersion the Abbe number defines, V_d = (n_d - 1) / (n_F - n_C):
+     n_F - n_C = B (1/lambda_F^2 - 1/lambda_C^2) = (n_d - 1) / V_d
+         gives B = (n_d - 1) / (V_d (1/lambda_F^2 - 1/lambda_C^2)),
+     n(lambda_d) = n_d
+         gives A = n_d - B / lambda_d^2. */
+double lens_index_at(const lens_surface *s, double wavelength_nm)
+{
+    if (s->abbe == 0.0)
+        return s->ior;
+    const double inv_f2 = 1.0 / (WAVELENGTH_F_NM * WAVELENGTH_F_NM);
+    const double inv_c2 = 1.0 / (WAVELENGTH_C_NM * WAVELENGTH_C_NM);
+    const double b = (s->ior - 1.0) / (s->abbe * (inv_f2 - inv_c2));
+    const double a = s->ior - b / (WAVELENGTH_D_NM * WAVELENGTH_D_NM);
+    return a + b / (wavelength_nm * wavelength_nm);
+}
+
+int lens_has_abbe(const lens *l)
+{
+    for (int i = 0; i < l->count; i++)
+        if (l->surface[i].abbe > 0.0)
+            return 1;
+    return 0;
 }
 
 /* A sphere of curvature c through the vertex, centre at vertex_z - 1/c, satisfies

@@ -2,9 +2,11 @@
 
    One row a surface, from the scene side to the film side, millimetres:
    radius (positive: centre of curvature on the film side; 0: the aperture stop),
-   thickness to the next surface, index of refraction behind the surface (0 on the stop row
-   means air), clear aperture diameter. Camera space puts the film at z = 0 and the lens toward
-   +z; surface i has its vertex at z = film_distance + sum of thicknesses of rows i .. n-2. */
+   thickness to the next surface, index of refraction behind the surface (n_d; 0 on the stop
+   row means air), clear aperture diameter, and optionally the Abbe number V_d of the medium
+   behind the surface (0 or absent for air; every glass row gives one or none does). Camera
+   space puts the film at z = 0 and the lens toward +z; surface i has its vertex at
+   z = film_distance + sum of thicknesses of rows i .. n-2. */
 #ifndef LENS2POV_LENS_H
 #define LENS2POV_LENS_H
 
@@ -17,6 +19,7 @@ typedef struct lens_surface {
     double thickness_mm;     /* axial distance to the next surface toward the film */
     double ior;              /* index of the medium behind this surface; 1 where the file says 0 */
     double aperture_mm;      /* clear aperture diameter (the stop: its largest opening) */
+    double abbe;             /* V_d of the medium behind; 0 for air or when the file gives none */
     double vertex_z_mm;      /* camera space; set by lens_set_film_distance */
     int line;                /* line of the file that gave this row */
 } lens_surface;
@@ -81,6 +84,14 @@ static inline const lens_blades *lens_blades_of(const lens *l, int i)
 {
     return i == l->stop && l->blades.count ? &l->blades : NULL;
 }
+
+/* Index of the medium behind surface s at this wavelength (nm): ior where the file gives no
+   Abbe number, else the Cauchy fit A + B / lambda^2 through n_d and V_d (lens.c,
+   docs/lenses.md). */
+double lens_index_at(const lens_surface *s, double wavelength_nm);
+
+/* 1 when the file gave Abbe numbers (its glass rows have a fifth column), else 0. */
+int lens_has_abbe(const lens *l);
 
 /* Front vertex to rear vertex: the sum of the thicknesses of rows 0 .. n-2. */
 double lens_total_length_mm(const lens *l);

@@ -1,0 +1,185 @@
+/* Tests of the lens library (every .dat file in lenses/, docs/lenses.md): every lens loads,
+   traces, renders a small picture, and has the focal length its header claims. One test a
+   lens, so that a new file in lenses/ is tested without a line here and Criterion names the
+   lens that fails. */
+#include <criterion/criterion.h>
+#include <criterion/parameterized.h>
+
+#include <glob.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "optics/lens.h"
+#include "support.h"
+
+/* The header line every library lens has, e.g. "# focal length: 50 mm, f-number: 2.8". */
+#define CLAIM_FORMAT "# focal length: %lf mm, f-number: %lf"
+
+/* The four CS348B lenses, which predate the Abbe number column. */
+static const char *const FOUR_COLUMN_LENSES[] = {"dgauss.50mm", "fisheye.10mm",
+                                                 "telephoto.250mm", "wide.22mm"};
+
+/* At least this many files: a glob that finds nothing must not pass. */
+enum { LIBRARY_MIN_LENSES = 18 };
+
+typedef struct library_lens {
+    char path[512];
+} library_lens;
+
+static void free_lenses(struct criterion_test_params *p)
+{
+    cr_free(p->params);
+}
+
+static size_t glob_lenses(glob_t *g)
+{
+    if (glob(LENS_DIR "*.dat", 0, NULL, g) != 0)
+        return 0;
+    return g->gl_pathc;
+}
+
+static struct criterion_test_params library(void)
+{
+    glob_t g;
+    const size_t n = glob_lenses(&g);
+    library_lens *lenses = cr_malloc((n ? n : 1) * sizeof *lenses);
+    for (size_t i = 0; i < n; i++)
+        snprintf(lenses[i].path, sizeof lenses[i].path, "%s", g.gl_pathv[i]);
+    if (n)
+        globfree(&g);
+    return cr_make_param_array(library_lens, lenses, n, free_lenses);
+}
+
+/* The claimed focal length and f-number from the header; fails the test without them. */
+static void read_claim(const char *path, double *focal_mm, double *f_number)
+{
+    size_t length;
+    char *text = read_text(path, &length);
+    cr_assert_not_null(text, "%s: unreadable", path);
+    const char *line = strstr(text, "# focal length: ");
+    cr_assert_not_null(line, "%s: no '# focal length: F mm, f-number: N' line", path);
+    cr_assert_eq(sscanf(line, CLAIM_FORMAT, focal_mm, f_number), 2, "%s: malformed: %.60s", path,
+                 line);
+    cr_assert(strstr(text, "Source:") != NULL, "%s: no 'Source:' in the header", path);
+    free(text);
+}
+
+/* A number of `info --json`'s output: "key": value. */
+static double json_number(const char *json, const char *key)
+{
+    char quoted[64];
+    snprintf(quoted, sizeof quoted, "\"%s\": ", key);
+    const char *p = strstr(json, quoted);
+    cr_assert_not_null(p, "no %s in: %s", key, json);
+    return strtod(p + strlen(quoted), NULL);
+}
+
+static const char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
+Test(library, has_the_lenses_docs_lenses_md_lists)
+{
+    glob_t g;
+    const size_t n = glob_lenses(&g);
+    cr_assert_geq(n, LIBRARY_MIN_LENSES, "%zu lens files in " LENS_DIR, n);
+    size_t length;
+    char *doc = read_text(LENS2POV_SOURCE_DIR "/docs/lenses.md", &length);
+    cr_assert_not_null(doc);
+    for (size_t i = 0; i < n; i++) {
+        char name[256];
+        snprintf(name, sizeof name, "`%s`", base_name(g.gl_pathv[i]));
+        cr_expect(strstr(doc, name) != NULL, "docs/lenses.md does not list %s", name);
+    }
+    free(doc);
+    globfree(&g);
+}
+
+ParameterizedTestParameters(library, loads_with_a_claim_and_abbe_numbers)
+{
+    return library();
+}
+
+ParameterizedTest(library_lens *l, library, loads_with_a_claim_and_abbe_numbers)
+{
+    lens s;
+    l2p_error err = {0};
+    cr_assert_eq(lens_read(l->path, &s, &err), L2P_OK, "%s", err.text);
+    double focal, f_number;
+    read_claim(l->path, &focal, &f_number);
+    cr_assert_gt(focal, 0.0);
+    cr_assert_gt(f_number, 0.0);
+    int four_columns = 0;
+    for (size_t i = 0; i < sizeof FOUR_COLUMN_LENSES / sizeof *FOUR_COLUMN_LENSES; i++)
+        four_columns |= strcmp(s.name, FOUR_COLUMN_LENSES[i]) == 0;
+    cr_expect_eq(lens_has_abbe(&s), !four_columns, "%s: Abbe numbers %s", l->path,
+                 four_columns ? "in a CS348B lens" : "missing");
+    lens_free(&s);
+}
+
+/* The focal length `info` computes is the claimed one within 2% (a transcription slip moves
+   it more); the f-number at full stop within 5% (the CS348B stops are pbrt's, not the
+   book's). */
+ParameterizedTestParameters(library, info_gives_the_claimed_focal_length)
+{
+    return library();
+}
+
+ParameterizedTest(library_lens *l, library, info_gives_the_claimed_focal_length)
+{
+    double focal, f_number;
+    read_claim(l->path, &focal, &f_number);
+    char *out = NULL, *errtext = NULL;
+    const int st = run_lens2pov(&out, &errtext, "info", l->path, "--json", NULL);
+    cr_assert_eq(st, 0, "%s: exit %d: %s", l->path, st, errtext);
+    const double efl = json_number(out, "efl_mm"), n = json_number(out, "f_number");
+    cr_expect_leq(fabs(efl / focal - 1.0), 0.02, "%s: focal length %.4g, claimed %.4g", l->path,
+                  efl, focal);
+    cr_expect_leq(fabs(n / f_number - 1.0), 0.05, "%s: f-number %.4g, claimed %.4g", l->path, n,
+                  f_number);
+    free(out);
+    free(errtext);
+}
+
+/* trace at infinity focus (the default look-at is closer than the telephoto focuses). */
+ParameterizedTestParameters(library, traces)
+{
+    return library();
+}
+
+ParameterizedTest(library_lens *l, library, traces)
+{
+    const char *dir = test_tmpdir();
+    char *errtext = NULL;
+    const int st = run_lens2pov(NULL, &errtext, "trace", l->path, "--width", "16", "--height",
+                                "12", "--spp", "2", "--focus-distance", "inf", "-o",
+                                tmp_path(dir, "p"), "--quiet", NULL);
+    cr_assert_eq(st, 0, "%s: exit %d: %s", l->path, st, errtext);
+    cr_expect(file_exists(tmp_path(dir, "p.inc")), "%s: no p.inc", l->path);
+    cr_expect(file_exists(tmp_path(dir, "p.map")), "%s: no p.map", l->path);
+    free(errtext);
+    remove_tree(dir);
+}
+
+/* render of the bundled scene with its own camera, tiny. */
+ParameterizedTestParameters(library, renders_the_bundled_scene)
+{
+    return library();
+}
+
+ParameterizedTest(library_lens *l, library, renders_the_bundled_scene)
+{
+    const char *dir = test_tmpdir();
+    char *errtext = NULL;
+    const int st = run_lens2pov(NULL, &errtext, "render", LENS2POV_SOURCE_DIR "/pov/scene.pov",
+                                l->path, "--width", "16", "--height", "12", "--spp", "2",
+                                "--jobs", "1", "-o", tmp_path(dir, "x.png"), "--quiet", NULL);
+    cr_assert_eq(st, 0, "%s: exit %d: %s", l->path, st, errtext);
+    cr_expect(file_exists(tmp_path(dir, "x.png")), "%s: no picture", l->path);
+    free(errtext);
+    remove_tree(dir);
+}
