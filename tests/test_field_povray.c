@@ -28,9 +28,7 @@ static int vertex_at(field_mesh *m, int px, int py)
     double x = px - 7.0, y = 3.0 - py;
     vec3 o = v3(0.7 * x, 0.9 * y, 0.05 * (x * x + y * y));
     vec3 d = v3(0.06 * x + 0.004 * x * y, 0.07 * y + 0.002 * x * x, 1.0);
-    double u, v;
-    povuv_pixel_uv(W, H, px, py, &u, &v);
-    return field_mesh_vertex(m, o, d, u, v);
+    return field_mesh_vertex(m, o, d, px, py);
 }
 
 static void build(field_mesh *m)
@@ -57,7 +55,7 @@ static double wrap(double t) { return t - floor(t + 0.5); }
 Test(field_povray, the_model_gives_the_rays_povray_traces)
 {
     field_mesh m;
-    field_mesh_init(&m);
+    field_mesh_init(&m, W, H);
     build(&m);
     const char *dir = test_tmpdir();
     static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0.25, -0.5, -5};

@@ -4,11 +4,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-void field_mesh_init(field_mesh *m) { memset(m, 0, sizeof *m); }
+void field_mesh_init(field_mesh *m, int render_w, int render_h)
+{
+    memset(m, 0, sizeof *m);
+    m->render_w = render_w;
+    m->render_h = render_h;
+}
 
 void field_mesh_free(field_mesh *m)
 {
-    free(m->pos), free(m->nrm), free(m->uv), free(m->tri);
+    free(m->pos), free(m->nrm), free(m->pix), free(m->uv), free(m->tri);
     memset(m, 0, sizeof *m);
 }
 
@@ -29,7 +34,7 @@ static int grow(void **p, int *cap, int need, size_t size)
     return 0;
 }
 
-int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double u, double v)
+int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double x, double y)
 {
     int cap = m->vertex_cap, need = m->vertices + 1;
     if (grow((void **)&m->pos, &cap, need, sizeof *m->pos) < 0)
@@ -40,11 +45,17 @@ int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double u, double v)
     cap = m->vertex_cap;
     if (grow((void **)&m->uv, &cap, need, sizeof *m->uv) < 0)
         return -1;
+    cap = m->vertex_cap;
+    if (grow((void **)&m->pix, &cap, need, sizeof *m->pix) < 0)
+        return -1;
     m->vertex_cap = cap;
     int k = m->vertices++;
     m->pos[k][0] = (float)pos.x, m->pos[k][1] = (float)pos.y, m->pos[k][2] = (float)pos.z;
     m->nrm[k][0] = (float)nrm.x, m->nrm[k][1] = (float)nrm.y, m->nrm[k][2] = (float)nrm.z;
-    m->uv[k][0] = u, m->uv[k][1] = v;
+    m->pix[k][0] = x, m->pix[k][1] = y;
+    /* povuv_pixel_uv for a position that need not be whole */
+    m->uv[k][0] = x / (m->render_w + 1);
+    m->uv[k][1] = 1.0 - (y + 1) / (m->render_h + 1);
     return k;
 }
 
@@ -55,6 +66,21 @@ int field_mesh_face(field_mesh *m, int a, int b, int c)
     int k = m->faces++;
     m->tri[k][0] = a, m->tri[k][1] = b, m->tri[k][2] = c;
     return k;
+}
+
+int field_mesh_append(field_mesh *m, const field_mesh *src, int dx, int dy)
+{
+    int base = m->vertices;
+    for (int i = 0; i < src->vertices; i++) {
+        vec3 p = v3(src->pos[i][0], src->pos[i][1], src->pos[i][2]);
+        vec3 n = v3(src->nrm[i][0], src->nrm[i][1], src->nrm[i][2]);
+        if (field_mesh_vertex(m, p, n, src->pix[i][0] + dx, src->pix[i][1] + dy) < 0)
+            return -1;
+    }
+    for (int k = 0; k < src->faces; k++)
+        if (field_mesh_face(m, base + src->tri[k][0], base + src->tri[k][1], base + src->tri[k][2]) < 0)
+            return -1;
+    return 0;
 }
 
 void field_mesh_povuv_face(const field_mesh *m, int k, povuv_face *f)
