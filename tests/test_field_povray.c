@@ -95,7 +95,7 @@ Test(field_povray, the_model_gives_the_rays_povray_traces)
                 continue;
             }
             vec3 o, d;
-            cr_assert(povuv_face_ray(&pm.face[k], u, v, false, &o, &d));
+            cr_assert(povuv_face_ray(&pm.face[k], u, v, &o, &d));
             o = v3_add(o, v3(world[9], world[10], world[11]));
             double t = (1000 - o.z) / d.z;
             double hx = o.x + t * d.x, hy = o.y + t * d.y;

@@ -74,13 +74,16 @@ void povuv_face_init(povuv_face *f, const double pos[3][3], const double nrm[3][
         f->uv[k][0] = uv[k][0];
         f->uv[k][1] = uv[k][1];
     }
-    memcpy(f->n_unswapped, f->n, sizeof f->n);
+    /* Parse_Mesh2: a face is smooth unless its normals are equal to within 1e-10 squared */
+    vec3 d1 = v3_sub(fv(f->n[0]), fv(f->n[1])), d2 = v3_sub(fv(f->n[0]), fv(f->n[2]));
+    f->smooth = fabs(v3_dot(d1, d1)) > POV_EPSILON || fabs(v3_dot(d2, d2)) > POV_EPSILON;
     f->swapped = needs_swap(fv(f->p[0]), fv(f->p[1]), fv(f->p[2]));
     if (f->swapped) {
         float t[3];
         double tuv[2];
         memcpy(t, f->p[0], sizeof t), memcpy(f->p[0], f->p[1], sizeof t), memcpy(f->p[1], t, sizeof t);
-        memcpy(t, f->n[0], sizeof t), memcpy(f->n[0], f->n[1], sizeof t), memcpy(f->n[1], t, sizeof t);
+        if (f->smooth)
+            memcpy(t, f->n[0], sizeof t), memcpy(f->n[0], f->n[1], sizeof t), memcpy(f->n[1], t, sizeof t);
         memcpy(tuv, f->uv[0], sizeof tuv), memcpy(f->uv[0], f->uv[1], sizeof tuv);
         memcpy(f->uv[1], tuv, sizeof tuv);
     }
@@ -98,13 +101,13 @@ void povuv_face_weights(const povuv_face *f, double u, double v, double b[3])
     b[2] = ((t[0][0] - u) * (t[1][1] - v) - (t[1][0] - u) * (t[0][1] - v)) / scale;
 }
 
-bool povuv_face_ray(const povuv_face *f, double u, double v, bool flat_order, vec3 *o, vec3 *d)
+bool povuv_face_ray(const povuv_face *f, double u, double v, vec3 *o, vec3 *d)
 {
     double b[3];
     povuv_face_weights(f, u, v, b);
     vec3 p1 = fv(f->p[0]), p2 = fv(f->p[1]), p3 = fv(f->p[2]);
     *o = v3_add(v3_add(v3_scale(p1, b[0]), v3_scale(p2, b[1])), v3_scale(p3, b[2]));
-    const float(*n)[3] = flat_order ? f->n_unswapped : f->n;
+    const float(*n)[3] = f->n;
     vec3 n1 = fv(n[0]), n2 = fv(n[1]), n3 = fv(n[2]);
     /* Smooth_Mesh_Normal: u measures from P1 (0) to edge P2-P3 (1) along Perp; the line from
        P1 through the point meets that edge at v (one coordinate, the edge's dominant axis);

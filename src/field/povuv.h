@@ -14,12 +14,12 @@
    the dominant axis of edge P2-P3. */
 typedef struct povuv_face {
     float p[3][3];      /* vertex positions, mesh space */
-    float n[3][3];      /* unit normals, in POV-Ray's (possibly swapped) order */
-    float n_unswapped[3][3]; /* the same in file order for 1 and 2: a face POV-Ray takes as flat */
+    float n[3][3];      /* unit normals, swapped with the vertices only for a smooth face */
     double uv[3][2];
     float perp[3];
     int vaxis;
-    bool swapped;
+    bool swapped;       /* vertices 1 and 2 (and their UVs) swapped */
+    bool smooth;        /* normals not all equal: |N1 - N2|^2 or |N1 - N3|^2 above 1e-10 */
 } povuv_face;
 
 /* A face from its file values (vertex k of the face: position, normal, UV). */
@@ -31,9 +31,8 @@ void povuv_face_init(povuv_face *f, const double pos[3][3], const double nrm[3][
 void povuv_face_weights(const povuv_face *f, double u, double v, double b[3]);
 
 /* The ray of (u, v) through the face, mesh space: origin = sum b_k P_k, direction the
-   normalized Smooth_Mesh_Normal. flat_order uses the normals in file order (what POV-Ray
-   does with a face it parsed as flat). False when the direction is not finite. */
-bool povuv_face_ray(const povuv_face *f, double u, double v, bool flat_order, vec3 *o, vec3 *d);
+   normalized Smooth_Mesh_Normal. False when the direction is not finite. */
+bool povuv_face_ray(const povuv_face *f, double u, double v, vec3 *o, vec3 *d);
 
 /* A whole mesh with POV-Ray's 10 x 10 UV grid of faces (Parse_Mesh_Camera). */
 typedef struct povuv_mesh {
