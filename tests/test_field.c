@@ -120,7 +120,7 @@ static void check_subimage(const char *lens, camera_options *o, double tol, uint
     field_mesh m;
     field_mesh_init(&m, field_render_size(w), field_render_size(h));
     l2p_error err;
-    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_BASE_CELL, &m, st, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_BASE_CELL, &m, NULL, st, &err), L2P_OK, "%s", err.text);
     char *text = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);
@@ -137,7 +137,7 @@ static void check_subimage(const char *lens, camera_options *o, double tol, uint
             vec3 fp = film_camera_from_raster(&c.film, c.crop_x0 + x + s.offset_x, c.crop_y0 + y + s.offset_y);
             ray r;
             double weight;
-            bool pass = camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &weight);
+            bool pass = pupil_reaches(&c.pupil, fp) && camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &weight);
             double u, v;
             povuv_pixel_uv(m.render_w, m.render_h, x, y, &u, &v);
             int face = povuv_mesh_find(&pm, u, v);

@@ -28,6 +28,8 @@ typedef struct cli {
     double angle_deg;            /* --angle: the horizontal field of view; NAN: not given */
     bool angle_scene;            /* --angle scene: the scene camera's */
     bool diagonal_given;         /* --film-diagonal (it contradicts --angle) */
+    bool field_sampling;         /* render --sampling field (docs/fields.md) */
+    double field_tolerance;      /* --field-tolerance, pixels [0.05] */
 } cli;
 
 /* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render): an

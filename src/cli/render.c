@@ -21,6 +21,7 @@
 #include "povray/povray.h"
 #include "raytable/chunk_name.h"
 #include "cli/sizecheck.h"
+#include "field/field_render.h"
 #include "raytable/raytable.h"
 
 static const char *temp_root(void)
@@ -341,10 +342,21 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     return st;
 }
 
+/* --sampling field: src/field/field_render.c does the rest. */
+static int field_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
+                            l2p_error *err)
+{
+    const field_render_options fo = {c->positional[0], ws->dir, c->output, jobs, cores_online(),
+                                     !c->quiet, c->field_tolerance};
+    return field_render(cam, &fo, err);
+}
+
 int render_command(const cli *given, l2p_error *err)
 {
     const int jobs = given->jobs > 0 ? given->jobs : cores_online();
     int st = check_inputs(given, err);
+    if (!st && given->field_sampling && given->rays_csv)
+        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--rays needs --sampling pixel");
     if (!st)
         st = size_check_render(given, given->keep_temp ? given->keep_temp : temp_root(), jobs,
                                err);
@@ -369,7 +381,8 @@ int render_command(const cli *given, l2p_error *err)
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
         !(st = make_workspace(&w, c, err))) {
-        st = trace_and_render(c, &cam, &w, jobs, &csv, err);
+        st = c->field_sampling ? field_and_render(c, &cam, &w, jobs, err)
+                               : trace_and_render(c, &cam, &w, jobs, &csv, err);
         remove_workspace(&w);
     }
     outfile_discard(&csv);   /* nothing when committed */

@@ -98,6 +98,9 @@ void field_mesh_povuv_face(const field_mesh *m, int k, povuv_face *f)
 /* %.9g gives back a float32 exactly; %.17g a dyadic UV exactly (it has few digits). */
 int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, const double world[12])
 {
+    /* as the pixel table's include (docs/povray.md, "Output and gamma"): raise the language
+       version to 3.7 only when it is lower, and put it back */
+    fprintf(out, "#if (version < 3.7)\n  #declare Lens2pov_Version = version;\n  #version 3.7;\n#end\n");
     fprintf(out, "#declare %s = mesh2 {\n  vertex_vectors { %d", name, m->vertices);
     for (int i = 0; i < m->vertices; i++)
         fprintf(out, ",\n<%.9g,%.9g,%.9g>", m->pos[i][0], m->pos[i][1], m->pos[i][2]);
@@ -115,5 +118,6 @@ int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, c
     for (int i = 0; i < 12; i++)
         fprintf(out, "%.17g%s", world[i], i < 11 ? ", " : "");
     fprintf(out, "> } smooth } }\n#undef %s\n", name);
+    fprintf(out, "#ifdef (Lens2pov_Version)\n  #version Lens2pov_Version;\n  #undef Lens2pov_Version\n#end\n");
     return ferror(out) ? -1 : 0;
 }

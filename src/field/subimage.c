@@ -37,6 +37,7 @@ typedef struct builder {
     int *vid;                  /* mesh vertex of a pixel, -1 when none yet */
     field_mesh *m;
     field_stats *st;
+    float *weights;            /* the caller's, may be NULL */
     bool oom;
 } builder;
 
@@ -64,10 +65,17 @@ static void trace_all(builder *b, film_sample s)
         camera_trace_batch(c, batch);
         for (int k = 0; k < batch->n; k++) {
             ray r = batch->out[k];
-            bool ok = batch->passed[k] && v3_isfinite(r.o) && v3_isfinite(r.d);
+            long i = start + k;
+            vec3 fp = film_camera_from_raster(&c->film, c->crop_x0 + i % b->w + s.offset_x,
+                                              c->crop_y0 + i / b->w + s.offset_y);
+            /* as with pixel sampling, a film point beyond the lens's reach is no sample */
+            bool ok = batch->passed[k] && pupil_reaches(&c->pupil, fp) && v3_isfinite(r.o) &&
+                      v3_isfinite(r.d) && isfinite(batch->weight[k]);
             r.o.z -= front;
-            b->rays[start + k] = r;
-            b->passed[start + k] = ok;
+            b->rays[i] = r;
+            b->passed[i] = ok;
+            if (b->weights)
+                b->weights[i] = ok ? (float)batch->weight[k] : 0.0f;
         }
     }
     free(batch);
@@ -300,9 +308,10 @@ static void build_grid(builder *b, int base)
 }
 
 int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
-                         field_mesh *out, field_stats *st, l2p_error *err)
+                         field_mesh *out, float *weights, field_stats *st, l2p_error *err)
 {
-    builder b = {.c = c, .tol = t, .w = c->crop_x1 - c->crop_x0, .h = c->crop_y1 - c->crop_y0, .m = out, .st = st};
+    builder b = {.c = c, .tol = t, .w = c->crop_x1 - c->crop_x0, .h = c->crop_y1 - c->crop_y0,
+                 .m = out, .st = st, .weights = weights};
     const size_t n = (size_t)b.w * b.h;
     memset(st, 0, sizeof *st);
     field_mesh_clear(out);

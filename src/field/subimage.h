@@ -32,10 +32,12 @@ enum { FIELD_BASE_CELL = 32 };   /* pixels between the vertices of the coarsest 
    mesh for a render of exactly the crop's size (vertex pixel positions are crop pixels):
    every pixel whose exact ray passes lies in at least one face, every face that contains it
    gives it a ray within the tolerance (checked here, with the model of povuv.c), and no face
-   contains a pixel the lens blocks. out is cleared first; its render size must be the
-   crop's. Returns L2P_OK, or L2P_FAILED when out of memory. */
+   contains a pixel the lens blocks (or whose film point is beyond the lens's reach, as with
+   pixel sampling). out is cleared first; its render size is field_render_size of the crop's.
+   weights (NULL, or one a crop pixel, row by row) gets each pixel's sample weight, 0 where
+   blocked. Returns L2P_OK, or L2P_FAILED when out of memory. */
 int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
-                         field_mesh *out, field_stats *st, l2p_error *err);
+                         field_mesh *out, float *weights, field_stats *st, l2p_error *err);
 
 /* The render size for a crop of w x h: the smallest 2^a - 1 >= w, 2^b - 1 >= h, so that UVs
    are short binary fractions. */
