@@ -210,3 +210,69 @@ Test(field, a_crop_every_pixel_within_the_tolerance)
     check_subimage("wide.22mm", &o, 0.05, 3, &st);
     check_subimage("fisheye.10mm", &o, 0.05, 2, &st);
 }
+
+/* Two sub-images moved side by side into one render (as field_render.c packs them): read back
+   through the model, every pixel of each still gets its exact ray within the tolerance, and
+   the pixels between and beyond them none. */
+Test(field, sub_images_moved_into_a_render_keep_their_rays)
+{
+    camera_options o = small(120, 90);
+    camera c;
+    test_camera(&c, "fisheye.10mm", &o);
+    field_tolerance t;
+    field_tolerance_of(&c, 0.05, &t);
+    const int w = 120, h = 90, rw = field_render_size(2 * w + 7), rh = field_render_size(h);
+    field_mesh render;
+    field_mesh_init(&render, rw, rh);
+    const int dx[2] = {0, w + 7};
+    for (int k = 0; k < 2; k++) {
+        field_mesh m;
+        field_stats st;
+        l2p_error err;
+        field_mesh_init(&m, field_render_size(w), field_render_size(h));
+        cr_assert_eq(field_build_subimage(&c, sobol_shared_sample(o.seed, (uint32_t)k), &t, FIELD_BASE_CELL,
+                                          &m, NULL, &st, &err), L2P_OK);
+        cr_assert_eq(field_mesh_append(&render, &m, dx[k], 0), 0);
+        field_mesh_free(&m);
+    }
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    cr_assert_eq(field_mesh_write_include(f, &render, "Field_Test", world), 0);
+    fclose(f);
+    povuv_mesh pm;
+    read_include(text, &pm);
+    const double front = c.lens.surface[0].vertex_z_mm;
+    for (int y = 0; y < rh; y++)
+        for (int x = 0; x < rw; x++) {
+            double u, v;
+            povuv_pixel_uv(rw, rh, x, y, &u, &v);
+            int face = povuv_mesh_find(&pm, u, v);
+            int k = x < w ? 0 : x >= dx[1] && x < dx[1] + w ? 1 : -1;
+            if (k < 0 || y >= h) {
+                cr_assert(face < 0, "pixel %d,%d outside the sub-images is traced", x, y);
+                continue;
+            }
+            film_sample s = sobol_shared_sample(o.seed, (uint32_t)k);
+            vec3 fp = film_camera_from_raster(&c.film, x - dx[k] + s.offset_x, y + s.offset_y);
+            ray r;
+            double weight;
+            bool pass = pupil_reaches(&c.pupil, fp) && camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &weight);
+            cr_assert_eq(face >= 0, pass, "pixel %d,%d: rendered %d, passes %d", x, y, face >= 0, pass);
+            if (face < 0)
+                continue;
+            vec3 mo, md;
+            cr_assert(povuv_face_ray(&pm.face[face], u, v, &mo, &md));
+            r.o.z -= front;
+            double angle = atan2(v3_length(v3_cross(r.d, md)), v3_dot(r.d, md));
+            vec3 e = v3_sub(mo, r.o);
+            double across = v3_length(v3_sub(e, v3_scale(r.d, v3_dot(e, r.d))));
+            cr_assert(angle <= t.angle_rad && across <= t.origin_mm, "pixel %d,%d: %g rad, %g mm", x, y,
+                      angle, across);
+        }
+    free(text);
+    povuv_mesh_free(&pm);
+    field_mesh_free(&render);
+    camera_free(&c);
+}

@@ -300,6 +300,12 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     pthread_mutex_init(&j.lock, NULL);
     int st = build_all(&j, o->jobs > 0 ? o->jobs : 1, err);
     pthread_mutex_destroy(&j.lock);
+    /* the image library, loading on render's thread meanwhile: fail before POV-Ray runs when
+       it cannot be loaded, and never leave while it is half loaded */
+    l2p_error lib_err;
+    const int lib = image_io_ready(&lib_err);
+    if (!st && lib)
+        st = l2p_fail(err, lib, NULL, 0, "%s", lib_err.text);
     if (!st) {
         int renders = pack(subs, spp, w, h, plans);
         st = render_and_develop(c, o, subs, plans, renders, err);
