@@ -357,7 +357,7 @@ int render_command(const cli *given, l2p_error *err)
     int st = check_inputs(given, err);
     if (!st && given->field_sampling && given->rays_csv)
         st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--rays needs --sampling pixel");
-    if (!st)
+    if (!st && !given->field_sampling)   /* its estimates are pixel sampling's */
         st = size_check_render(given, given->keep_temp ? given->keep_temp : temp_root(), jobs,
                                err);
     if (st)

@@ -16,7 +16,7 @@
 
 typedef struct sub {
     field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
-    float *weights;            /* one a crop pixel */
+    float *weights;            /* one a crop pixel, while building; then in its file */
     field_stats stats;
     int render, dx, dy;        /* where it is rendered */
 } sub;
@@ -29,6 +29,7 @@ typedef struct render_plan {
 
 typedef struct job {
     const camera *c;
+    const char *work_dir;
     const field_tolerance *tol;
     sub *subs;
     int spp;
@@ -39,6 +40,42 @@ typedef struct job {
 } job;
 
 /* ---------------------------------------------------------------- building */
+
+/* WORK/field.fNNN.EXT: render NNN's include, ini and EXR, or sub-image NNN's weights. */
+static char *name_of(const char *dir, int k, const char *ext)
+{
+    size_t n = strlen(dir) + 32;
+    char *s = malloc(n);
+    if (s)
+        snprintf(s, n, "%s/field.f%03d.%s", dir, k, ext);
+    return s;
+}
+
+/* A sub-image's weights go to the workspace (WORK/field.fNNN.weights, raw float32) until
+   developing: spp of them in memory would be spp times the picture. */
+static int save_weights(const job *j, int k, const float *weights, size_t n, l2p_error *e)
+{
+    char *path = name_of(j->work_dir, k, "weights");
+    FILE *f = path ? fopen(path, "wb") : NULL;
+    bool ok = f && fwrite(weights, sizeof *weights, n, f) == n;
+    if (f && fclose(f) != 0)
+        ok = false;
+    int st = ok ? L2P_OK : l2p_fail(e, L2P_FAILED, path, 0, "cannot write");
+    free(path);
+    return st;
+}
+
+static int load_weights(const char *dir, int k, float *weights, size_t n, l2p_error *err)
+{
+    char *path = name_of(dir, k, "weights");
+    FILE *f = path ? fopen(path, "rb") : NULL;
+    bool ok = f && fread(weights, sizeof *weights, n, f) == n;
+    if (f)
+        fclose(f);
+    int st = ok ? L2P_OK : l2p_fail(err, L2P_FAILED, path, 0, "cannot read");
+    free(path);
+    return st;
+}
 
 static void *build_worker(void *arg)
 {
@@ -60,6 +97,10 @@ static void *build_worker(void *arg)
                           "--field-tolerance %g needs %d faces for %zu pixels in sub-image %d: "
                           "use a larger tolerance or --sampling pixel", j->tol->pixels,
                           s->stats.faces, pixels, k);
+        if (!st)
+            st = save_weights(j, k, s->weights, pixels, &e);
+        free(s->weights);
+        s->weights = NULL;
         if (st) {
             pthread_mutex_lock(&j->lock);
             if (atomic_load(&j->status) == L2P_OK) {
@@ -136,15 +177,6 @@ static int pack(sub *subs, int spp, int w, int h, render_plan *plans)
 
 /* ---------------------------------------------------------------- files */
 
-static char *name_of(const char *dir, int k, const char *ext)
-{
-    size_t n = strlen(dir) + 32;
-    char *s = malloc(n);
-    if (s)
-        snprintf(s, n, "%s/field.f%03d.%s", dir, k, ext);
-    return s;
-}
-
 /* Mesh space (camera space less the front vertex, mm) to the world: POV-Ray's matrix rows are
    the images of x, y and z, then the translation. */
 static void world_matrix(const camera *c, double m[12])
@@ -194,23 +226,29 @@ static int write_render(const camera *c, const sub *subs, const render_plan *p, 
 
 /* ---------------------------------------------------------------- developing */
 
-static int develop_render(const render_plan *p, const sub *subs, const char *exr, int w, int h,
-                          double *sums, l2p_error *err)
+static int develop_render(const render_plan *p, const sub *subs, const char *exr, const char *dir,
+                          int w, int h, double *sums, l2p_error *err)
 {
     int iw, ih;
-    float *rgba;
+    float *rgba, *weights = malloc(sizeof *weights * (size_t)w * h);
+    if (!weights)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     int st = image_read_rgba(exr, &iw, &ih, &rgba, err);
-    if (st)
+    if (st) {
+        free(weights);
         return st;
+    }
     if (iw != p->width + 1 || ih != p->height + 1) {
-        free(rgba);
+        free(rgba), free(weights);
         return l2p_fail(err, L2P_FAILED, exr, 0, "is %dx%d, not %dx%d", iw, ih, p->width + 1, p->height + 1);
     }
-    for (int i = 0; i < p->count; i++) {
+    for (int i = 0; i < p->count && !st; i++) {
         const sub *s = &subs[p->first + i];
+        if ((st = load_weights(dir, p->first + i, weights, (size_t)w * h, err)))
+            break;
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++) {
-                const float wt = s->weights[(size_t)y * w + x];
+                const float wt = weights[(size_t)y * w + x];
                 if (wt <= 0)
                     continue;   /* blocked: no face, black */
                 const float *px = rgba + 4 * ((size_t)(s->dy + y + 1) * iw + s->dx + x);
@@ -218,8 +256,8 @@ static int develop_render(const render_plan *p, const sub *subs, const char *exr
                     sums[3 * ((size_t)y * w + x) + ch] += (double)wt * px[ch];
             }
     }
-    free(rgba);
-    return L2P_OK;
+    free(rgba), free(weights);
+    return st;
 }
 
 static void fill_header(const camera *c, samplemap_header *h)
@@ -265,7 +303,7 @@ static int render_and_develop(const camera *c, const field_render_options *o, su
     if (!st && !sums)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int r = 0; r < renders && !st; r++)
-        st = develop_render(&plans[r], subs, ch[r].output_exr, w, h, sums, err);
+        st = develop_render(&plans[r], subs, ch[r].output_exr, o->work_dir, w, h, sums, err);
     if (!st) {
         samplemap map = {.records = NULL};
         fill_header(c, &map.header);
@@ -294,7 +332,7 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     }
     for (int k = 0; k < spp; k++)
         field_mesh_init(&subs[k].mesh, field_render_size(w), field_render_size(h));
-    job j = {.c = c, .tol = &tol, .subs = subs, .spp = spp};
+    job j = {.c = c, .work_dir = o->work_dir, .tol = &tol, .subs = subs, .spp = spp};
     atomic_init(&j.next, 0);
     atomic_init(&j.status, L2P_OK);
     pthread_mutex_init(&j.lock, NULL);
