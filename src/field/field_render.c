@@ -140,10 +140,11 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
     *rh = field_render_size((n + nx - 1) / nx * h);
 }
 
-/* Groups consecutive sub-images into renders: as many as the face budget takes, choosing the
-   count and grid whose render wastes the fewest pixels (its sides are 2^a - 1: every UV a short
-   binary fraction). Returns the number of renders. */
-static int pack(sub *subs, int spp, int w, int h, render_plan *plans)
+/* Groups consecutive sub-images into renders: as many as the face budget takes, at most
+   most_per_render (so that every POV-Ray job gets a share), choosing the count and grid whose
+   render wastes the fewest pixels (its sides are 2^a - 1: every UV a short binary fraction).
+   Returns the number of renders. */
+static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_plan *plans)
 {
     int renders = 0;
     for (int first = 0; first < spp; renders++) {
@@ -152,7 +153,7 @@ static int pack(sub *subs, int spp, int w, int h, render_plan *plans)
         long long faces = 0;
         for (int n = 1; first + n <= spp; n++) {
             faces += subs[first + n - 1].stats.faces;
-            if (n > 1 && faces > FIELD_FACES_PER_RENDER)
+            if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render))
                 break;
             for (int nx = 1; nx <= n; nx++) {
                 int rw, rh;
@@ -345,7 +346,8 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     if (!st && lib)
         st = l2p_fail(err, lib, NULL, 0, "%s", lib_err.text);
     if (!st) {
-        int renders = pack(subs, spp, w, h, plans);
+        const int jobs = o->jobs > 0 ? o->jobs : 1;
+        int renders = pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
         st = render_and_develop(c, o, subs, plans, renders, err);
     }
     for (int k = 0; k < spp; k++)
