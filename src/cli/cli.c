@@ -59,6 +59,11 @@ static const cli_option OPTIONS[] = {
      "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"},
     {"--scene", NULL, CMD_TRACE, false, false,
      "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"},
+    {"--sampling", NULL, CMD_RENDER, false, false,
+     "  --sampling pixel|field        exact rays, or ray fields: spp sub-images of shared\n"
+     "                                samples drawn by coarse meshes [pixel]\n"},
+    {"--field-tolerance", NULL, CMD_RENDER, false, false,
+     "  --field-tolerance PX          field rays' largest error, in pixels [0.05]\n"},
     {"--keep-temp", NULL, CMD_RENDER, false, false,
      "  --keep-temp DIR               keep the ray tables, renders and logs [removed]\n"},
     {"--quiet", "-q", CMD_TRACE, true, false,
@@ -225,7 +230,14 @@ static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
         c->keep_temp = v;
     else if (!strcmp(opt, "--scene"))
         c->scene = v;
-    else if (!strcmp(opt, "--jobs"))   /* outfile.c stops at most 256 children on a signal */
+    else if (!strcmp(opt, "--sampling")) {
+        if (strcmp(v, "pixel") && strcmp(v, "field"))
+            return value_bad(err, opt, "pixel or field", v);
+        c->field_sampling = !strcmp(v, "field");
+    } else if (!strcmp(opt, "--field-tolerance")) {
+        if (!value_double(v, &c->field_tolerance) || !(c->field_tolerance > 0))
+            return value_bad(err, opt, "pixels above 0 (for exact rays: --sampling pixel)", v);
+    } else if (!strcmp(opt, "--jobs"))   /* outfile.c stops at most 256 children on a signal */
         return value_int_up_to(opt, v, JOBS_MOST, &c->jobs, err);
     else if (!strcmp(opt, "--memory-mb"))  /* up to 1 PiB: render converts it to a face count */
         return value_positive_double(opt, v, &c->memory_mb, err) ? L2P_BAD_INPUT
@@ -329,6 +341,7 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
     memset(c, 0, sizeof *c);
     camera_options_default(&c->cam);
     c->angle_deg = NAN;
+    c->field_tolerance = 0.05;
     const char *cmd_name = first > 0 ? argv[first - 1] : "";
     const unsigned command = command_bit(cmd_name);
     if (!command)

@@ -30,6 +30,8 @@ typedef struct cli {
     bool diagonal_given;         /* --film-diagonal (it contradicts --angle) */
     char *const *povray_args;    /* render: POV-Ray's own options, after "--" */
     int povray_arg_count;
+    bool field_sampling;         /* render --sampling field (docs/fields.md) */
+    double field_tolerance;      /* --field-tolerance, pixels [0.05] */
 } cli;
 
 /* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render): an

@@ -23,6 +23,7 @@
 #include "povray/povray.h"
 #include "raytable/chunk_name.h"
 #include "cli/sizecheck.h"
+#include "field/field_render.h"
 #include "raytable/raytable.h"
 
 static const char *temp_root(void)
@@ -380,6 +381,15 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     return st;
 }
 
+/* --sampling field: src/field/field_render.c does the rest. */
+static int field_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
+                            l2p_error *err)
+{
+    const field_render_options fo = {c->positional[0], ws->dir, c->output, jobs, cores_online(),
+                                     !c->quiet, c->field_tolerance};
+    return field_render(cam, &fo, err);
+}
+
 /* Table t: its camera, then its frames. */
 static int render_table(const render_frames *rf, int t, const workspace *ws, int jobs,
                         outfile *csv, l2p_error *err)
@@ -399,7 +409,8 @@ static int render_table(const render_frames *rf, int t, const workspace *ws, int
         if (!(st = framing_camera_setup(&cam, &l, c, err))) {
             if (t == 0)
                 cli_warn(c, &cam);
-            st = trace_and_render(c, &cam, ws, jobs, csv, &tf, t, err);
+            st = c->field_sampling ? field_and_render(c, &cam, ws, jobs, err)
+                                   : trace_and_render(c, &cam, ws, jobs, csv, &tf, t, err);
         }
         camera_free(&cam);   /* also after a failed setup, as it always was */
     }
@@ -421,7 +432,12 @@ int render_command(const cli *given, l2p_error *err)
 {
     const int jobs = given->jobs > 0 ? given->jobs : cores_online();
     int st = check_inputs(given, err);
-    if (!st)
+    if (!st && given->field_sampling && given->rays_csv)
+        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--rays needs --sampling pixel");
+    if (!st && given->field_sampling && given->povray_args)
+        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "POV-Ray's options after -- (animations) need "
+                      "--sampling pixel");
+    if (!st && !given->field_sampling)   /* its estimates are pixel sampling's */
         st = size_check_render(given, given->keep_temp ? given->keep_temp : temp_root(), jobs,
                                err);
     if (st)

@@ -135,8 +135,8 @@ static int fill_attributes(const samplemap_header *h, metadata_text *t, image_at
     return (int)(sizeof list / sizeof list[0]);
 }
 
-static int write_picture(const samplemap *map, const double *sums, const char *out_path,
-                         l2p_error *err)
+int develop_write_picture(const samplemap *map, const double *sums, const char *out_path,
+                          l2p_error *err)
 {
     const samplemap_header *h = &map->header;
     float *rgb = malloc(sizeof *rgb * 3 * (size_t)crop_width(h) * (size_t)crop_height(h));
@@ -169,7 +169,7 @@ int develop_files(const samplemap *map, const char *const *renders, int render_c
     for (int k = 0; k < render_count && !st; k++)
         st = develop_one(map, k, renders[k], sums, err);
     if (!st)
-        st = write_picture(map, sums, out_path, err);
+        st = develop_write_picture(map, sums, out_path, err);
     free(sums);
     return st;
 }

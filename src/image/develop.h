@@ -18,6 +18,11 @@ int develop_accumulate(const samplemap *map, long long chunk, const float *rgba,
    count as black: that is vignetting). rgb gets 3 floats a crop pixel. */
 void develop_finish(const samplemap *map, const double *sums, float *rgb);
 
+/* develop_finish, then the picture written to out_path with the metadata below: only the
+   map's header is used (crop, spp, what the picture was made with). */
+int develop_write_picture(const samplemap *map, const double *sums, const char *out_path,
+                          l2p_error *err);
+
 /* The whole develop step: reads every chunk's render, accumulates, writes out_path with the
    lens, f-number, focus distance, film distance, film diagonal and spp as metadata. renders[k]
    is chunk k's render; render_count must be samplemap_chunk_count (else L2P_BAD_INPUT). The

@@ -1,0 +1,362 @@
+/* render --sampling field: sub-images built on worker threads, packed into POV-Ray renders of
+   at most FIELD_FACES_PER_RENDER faces, rendered by the chunk runner, developed here. */
+#include "field/field_render.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "field/sobol.h"
+#include "field/subimage.h"
+#include "image/develop.h"
+#include "image/image_io.h"
+#include "optics/pupil.h"
+#include "povray/povray.h"
+
+typedef struct sub {
+    field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
+    float *weights;            /* one a crop pixel, while building; then in its file */
+    field_stats stats;
+    int render, dx, dy;        /* where it is rendered */
+} sub;
+
+typedef struct render_plan {
+    int width, height;         /* final picture (POV-Ray renders one more each way) */
+    int first, count;          /* its sub-images */
+    long long faces;
+} render_plan;
+
+typedef struct job {
+    const camera *c;
+    const char *work_dir;
+    const field_tolerance *tol;
+    sub *subs;
+    int spp;
+    atomic_int next;
+    atomic_int status;
+    l2p_error err;
+    pthread_mutex_t lock;
+} job;
+
+/* ---------------------------------------------------------------- building */
+
+/* WORK/field.fNNN.EXT: render NNN's include, ini and EXR, or sub-image NNN's weights. */
+static char *name_of(const char *dir, int k, const char *ext)
+{
+    size_t n = strlen(dir) + 32;
+    char *s = malloc(n);
+    if (s)
+        snprintf(s, n, "%s/field.f%03d.%s", dir, k, ext);
+    return s;
+}
+
+/* A sub-image's weights go to the workspace (WORK/field.fNNN.weights, raw float32) until
+   developing: spp of them in memory would be spp times the picture. */
+static int save_weights(const job *j, int k, const float *weights, size_t n, l2p_error *e)
+{
+    char *path = name_of(j->work_dir, k, "weights");
+    FILE *f = path ? fopen(path, "wb") : NULL;
+    bool ok = f && fwrite(weights, sizeof *weights, n, f) == n;
+    if (f && fclose(f) != 0)
+        ok = false;
+    int st = ok ? L2P_OK : l2p_fail(e, L2P_FAILED, path, 0, "cannot write");
+    free(path);
+    return st;
+}
+
+static int load_weights(const char *dir, int k, float *weights, size_t n, l2p_error *err)
+{
+    char *path = name_of(dir, k, "weights");
+    FILE *f = path ? fopen(path, "rb") : NULL;
+    bool ok = f && fread(weights, sizeof *weights, n, f) == n;
+    if (f)
+        fclose(f);
+    int st = ok ? L2P_OK : l2p_fail(err, L2P_FAILED, path, 0, "cannot read");
+    free(path);
+    return st;
+}
+
+static void *build_worker(void *arg)
+{
+    job *j = arg;
+    const size_t pixels = (size_t)(j->c->crop_x1 - j->c->crop_x0) * (j->c->crop_y1 - j->c->crop_y0);
+    for (int k; atomic_load(&j->status) == L2P_OK && (k = atomic_fetch_add(&j->next, 1)) < j->spp;) {
+        sub *s = &j->subs[k];
+        l2p_error e;
+        s->weights = malloc(pixels * sizeof *s->weights);
+        int st = s->weights ? field_build_subimage(j->c, sobol_shared_sample(j->c->samples.seed, (uint32_t)k),
+                                                   j->tol, FIELD_BASE_CELL, &s->mesh, s->weights, &s->stats, &e)
+                            : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
+        if (!st && !(s->stats.worst_pixels <= j->tol->pixels))
+            st = l2p_fail(&e, L2P_BAD_INPUT, NULL, 0,
+                          "--field-tolerance %g is finer than POV-Ray's float32 rays can hold "
+                          "(sub-image %d): use a larger tolerance or --sampling pixel", j->tol->pixels, k);
+        if (!st && (size_t)s->stats.faces > pixels)
+            st = l2p_fail(&e, L2P_BAD_INPUT, NULL, 0,
+                          "--field-tolerance %g needs %d faces for %zu pixels in sub-image %d: "
+                          "use a larger tolerance or --sampling pixel", j->tol->pixels,
+                          s->stats.faces, pixels, k);
+        if (!st)
+            st = save_weights(j, k, s->weights, pixels, &e);
+        free(s->weights);
+        s->weights = NULL;
+        if (st) {
+            pthread_mutex_lock(&j->lock);
+            if (atomic_load(&j->status) == L2P_OK) {
+                j->err = e;
+                atomic_store(&j->status, st);
+            }
+            pthread_mutex_unlock(&j->lock);
+        }
+    }
+    return NULL;
+}
+
+static int build_all(job *j, int threads, l2p_error *err)
+{
+    pthread_t t[64];
+    int started = 0;
+    if (threads > 64)
+        threads = 64;
+    for (int i = 0; i < threads; i++)
+        if (pthread_create(&t[started], NULL, build_worker, j) == 0)
+            started++;
+    if (started == 0)
+        build_worker(j);
+    for (int i = 0; i < started; i++)
+        pthread_join(t[i], NULL);
+    if (atomic_load(&j->status))
+        *err = j->err;
+    return atomic_load(&j->status);
+}
+
+/* ---------------------------------------------------------------- packing */
+
+/* n sub-images of w x h in a grid of nx columns: the render's final size. */
+static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
+{
+    *rw = field_render_size(nx * w);
+    *rh = field_render_size((n + nx - 1) / nx * h);
+}
+
+/* Groups consecutive sub-images into renders: as many as the face budget takes, at most
+   most_per_render (so that every POV-Ray job gets a share), choosing the count and grid whose
+   render wastes the fewest pixels (its sides are 2^a - 1: every UV a short binary fraction).
+   Returns the number of renders. */
+static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_plan *plans)
+{
+    int renders = 0;
+    for (int first = 0; first < spp; renders++) {
+        double best = INFINITY;
+        int best_n = 1, best_nx = 1;
+        long long faces = 0;
+        for (int n = 1; first + n <= spp; n++) {
+            faces += subs[first + n - 1].stats.faces;
+            if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render))
+                break;
+            for (int nx = 1; nx <= n; nx++) {
+                int rw, rh;
+                grid_size(n, nx, w, h, &rw, &rh);
+                double cost = (double)(rw + 1) * (rh + 1) / n;
+                if (cost <= best)
+                    best = cost, best_n = n, best_nx = nx;
+            }
+        }
+        render_plan *p = &plans[renders];
+        grid_size(best_n, best_nx, w, h, &p->width, &p->height);
+        p->first = first, p->count = best_n, p->faces = 0;
+        for (int i = 0; i < best_n; i++) {
+            sub *s = &subs[first + i];
+            s->render = renders, s->dx = i % best_nx * w, s->dy = i / best_nx * h;
+            p->faces += s->stats.faces;
+        }
+        first += best_n;
+    }
+    return renders;
+}
+
+/* ---------------------------------------------------------------- files */
+
+/* Mesh space (camera space less the front vertex, mm) to the world: POV-Ray's matrix rows are
+   the images of x, y and z, then the translation. */
+static void world_matrix(const camera *c, double m[12])
+{
+    vec3 axis[3] = {camera_world_from_camera_offset(c, v3(1, 0, 0)),
+                    camera_world_from_camera_offset(c, v3(0, 1, 0)),
+                    camera_world_from_camera_offset(c, v3(0, 0, 1))};
+    vec3 t = camera_world_from_camera_point(c, v3(0, 0, c->lens.surface[0].vertex_z_mm));
+    for (int i = 0; i < 3; i++)
+        m[3 * i] = axis[i].x, m[3 * i + 1] = axis[i].y, m[3 * i + 2] = axis[i].z;
+    m[9] = t.x, m[10] = t.y, m[11] = t.z;
+}
+
+/* The render's include (its sub-images moved into place) and its ini: (W+1) x (H+1) pixels,
+   rows 2.. and columns ..W only (FS#261, docs/povray.md). */
+static int write_render(const camera *c, const sub *subs, const render_plan *p, const povray_chunk *ch,
+                        l2p_error *err)
+{
+    field_mesh m;
+    field_mesh_init(&m, p->width, p->height);
+    int st = L2P_OK;
+    for (int i = 0; i < p->count && !st; i++)
+        if (field_mesh_append(&m, &subs[p->first + i].mesh, subs[p->first + i].dx, subs[p->first + i].dy) < 0)
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    double world[12];
+    world_matrix(c, world);
+    FILE *f = st ? NULL : fopen(ch->include_path, "w");
+    if (!st && (!f || field_mesh_write_include(f, &m, "Lens2pov_Field", world) < 0))
+        st = l2p_fail(err, L2P_FAILED, ch->include_path, 0, "cannot write");
+    if (f && fclose(f) != 0 && !st)
+        st = l2p_fail(err, L2P_FAILED, ch->include_path, 0, "cannot write");
+    field_mesh_free(&m);
+    f = st ? NULL : fopen(ch->ini_path, "w");
+    if (!st && !f)
+        return l2p_fail(err, L2P_FAILED, ch->ini_path, 0, "cannot write");
+    if (f) {
+        const bool q = povray_ini_needs_quotes(ch->output_exr);
+        fprintf(f, "; lens2pov: a ray-field render, final pixel (x, y) at image pixel (x, y + 1)\n"
+                   "Width=%d\nHeight=%d\nStart_Row=2\nEnd_Column=%d\nAntialias=Off\n"
+                   "Output_File_Type=E\nOutput_To_File=On\nOutput_File_Name=%s%s%s\nDisplay=Off\n",
+                p->width + 1, p->height + 1, p->width, q ? "\"" : "", ch->output_exr, q ? "\"" : "");
+        if (fclose(f) != 0)
+            st = l2p_fail(err, L2P_FAILED, ch->ini_path, 0, "cannot write");
+    }
+    return st;
+}
+
+/* ---------------------------------------------------------------- developing */
+
+static int develop_render(const render_plan *p, const sub *subs, const char *exr, const char *dir,
+                          int w, int h, double *sums, l2p_error *err)
+{
+    int iw, ih;
+    float *rgba, *weights = malloc(sizeof *weights * (size_t)w * h);
+    if (!weights)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    int st = image_read_rgba(exr, &iw, &ih, &rgba, err);
+    if (st) {
+        free(weights);
+        return st;
+    }
+    if (iw != p->width + 1 || ih != p->height + 1) {
+        free(rgba), free(weights);
+        return l2p_fail(err, L2P_FAILED, exr, 0, "is %dx%d, not %dx%d", iw, ih, p->width + 1, p->height + 1);
+    }
+    for (int i = 0; i < p->count && !st; i++) {
+        const sub *s = &subs[p->first + i];
+        if ((st = load_weights(dir, p->first + i, weights, (size_t)w * h, err)))
+            break;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                const float wt = weights[(size_t)y * w + x];
+                if (wt <= 0)
+                    continue;   /* blocked: no face, black */
+                const float *px = rgba + 4 * ((size_t)(s->dy + y + 1) * iw + s->dx + x);
+                for (int ch = 0; ch < 3; ch++)
+                    sums[3 * ((size_t)y * w + x) + ch] += (double)wt * px[ch];
+            }
+    }
+    free(rgba), free(weights);
+    return st;
+}
+
+static void fill_header(const camera *c, samplemap_header *h)
+{
+    memset(h, 0, sizeof *h);
+    h->film_width = c->film.width, h->film_height = c->film.height;
+    h->spp = c->samples.spp;
+    h->crop_x0 = c->crop_x0, h->crop_y0 = c->crop_y0, h->crop_x1 = c->crop_x1, h->crop_y1 = c->crop_y1;
+    snprintf(h->lens, sizeof h->lens, "%s", c->lens.name ? c->lens.name : "");
+    snprintf(h->pupil, sizeof h->pupil, "%s", pupil_kind_name(c->pupil.kind));
+    snprintf(h->trace, sizeof h->trace, "%s", c->trace == TRACE_KIND_THICK ? "thick" : "full");
+    snprintf(h->weighting, sizeof h->weighting, "%s",
+             c->weighting == WEIGHTING_PHYSICAL ? "physical" : "normalized");
+    h->f_number = c->f_number;
+    h->aperture_diameter_mm = c->lens.stop_diameter_mm;
+    h->focus_distance_units = c->focus_distance_units;
+    h->film_distance_mm = c->lens.film_distance_mm;
+    h->film_diagonal_mm = c->film.diagonal_mm;
+    h->unit_mm = c->unit_mm;
+}
+
+/* ---------------------------------------------------------------- the whole */
+
+static int render_and_develop(const camera *c, const field_render_options *o, sub *subs,
+                              const render_plan *plans, int renders, l2p_error *err)
+{
+    const int w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
+    povray_chunk *ch = calloc((size_t)renders, sizeof *ch);
+    int st = ch ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int r = 0; r < renders && !st; r++) {
+        ch[r] = (povray_chunk){.include_path = name_of(o->work_dir, r, "inc"),
+                               .ini_path = name_of(o->work_dir, r, "ini"),
+                               .output_exr = name_of(o->work_dir, r, "exr"),
+                               .faces = plans[r].faces};
+        if (!ch[r].include_path || !ch[r].ini_path || !ch[r].output_exr)
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+        else
+            st = write_render(c, subs, &plans[r], &ch[r], err);
+    }
+    /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
+    const povray_options po = {.scene_path = o->scene_path, .work_dir = o->work_dir,
+                               .jobs = o->jobs, .threads_per_job = o->threads_per_job,
+                               .show_progress = o->progress, .film_width = c->film.width,
+                               .film_height = c->film.height};
+    if (!st)
+        st = povray_render_chunks(ch, renders, &po, err);
+    double *sums = st ? NULL : calloc(3 * (size_t)w * h, sizeof *sums);
+    if (!st && !sums)
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int r = 0; r < renders && !st; r++)
+        st = develop_render(&plans[r], subs, ch[r].output_exr, o->work_dir, w, h, sums, err);
+    if (!st) {
+        samplemap map = {.records = NULL};
+        fill_header(c, &map.header);
+        st = develop_write_picture(&map, sums, o->output, err);
+    }
+    free(sums);
+    for (int r = 0; ch && r < renders; r++)
+        free((char *)ch[r].include_path), free((char *)ch[r].ini_path), free((char *)ch[r].output_exr);
+    free(ch);
+    return st;
+}
+
+int field_render(const camera *c, const field_render_options *o, l2p_error *err)
+{
+    if (!(o->tolerance_px > 0) || !isfinite(o->tolerance_px))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+                        "--field-tolerance must be a number of pixels above 0 (for exact rays, use --sampling pixel)");
+    const int spp = c->samples.spp, w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
+    field_tolerance tol;
+    field_tolerance_of(c, o->tolerance_px, &tol);
+    sub *subs = calloc((size_t)spp, sizeof *subs);
+    render_plan *plans = calloc((size_t)spp, sizeof *plans);
+    if (!subs || !plans) {
+        free(subs), free(plans);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
+    for (int k = 0; k < spp; k++)
+        field_mesh_init(&subs[k].mesh, field_render_size(w), field_render_size(h));
+    job j = {.c = c, .work_dir = o->work_dir, .tol = &tol, .subs = subs, .spp = spp};
+    atomic_init(&j.next, 0);
+    atomic_init(&j.status, L2P_OK);
+    pthread_mutex_init(&j.lock, NULL);
+    int st = build_all(&j, o->jobs > 0 ? o->jobs : 1, err);
+    pthread_mutex_destroy(&j.lock);
+    /* the image library, loading on render's thread meanwhile: fail before POV-Ray runs when
+       it cannot be loaded, and never leave while it is half loaded */
+    l2p_error lib_err;
+    const int lib = image_io_ready(&lib_err);
+    if (!st && lib)
+        st = l2p_fail(err, lib, NULL, 0, "%s", lib_err.text);
+    if (!st) {
+        const int jobs = o->jobs > 0 ? o->jobs : 1;
+        int renders = pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
+        st = render_and_develop(c, o, subs, plans, renders, err);
+    }
+    for (int k = 0; k < spp; k++)
+        field_mesh_free(&subs[k].mesh), free(subs[k].weights);
+    free(subs), free(plans);
+    return st;
+}

@@ -1,0 +1,29 @@
+/* render --sampling field: the picture as spp sub-images, each the whole crop seen with one
+   shared sample and drawn by an adaptive distribution-3 mesh; several sub-images a POV-Ray
+   render; developed with each pixel's weight. docs/fields.md has the design. */
+#ifndef LENS2POV_FIELD_FIELD_RENDER_H
+#define LENS2POV_FIELD_FIELD_RENDER_H
+
+#include <stdbool.h>
+#include "camera/camera.h"
+
+typedef struct field_render_options {
+    const char *scene_path;    /* the user's scene */
+    const char *work_dir;      /* the workspace: includes, inis, renders, logs */
+    const char *output;        /* the picture */
+    int jobs;                  /* POV-Ray processes at once, and threads building meshes */
+    int threads_per_job;       /* +WTn; 0: POV-Ray's default */
+    bool progress;
+    double tolerance_px;       /* --field-tolerance */
+} field_render_options;
+
+/* Faces a POV-Ray render holds at most (a sub-image with more gets a render of its own):
+   POV-Ray's per-pixel face search grows with the faces in a UV grid cell. */
+enum { FIELD_FACES_PER_RENDER = 20000 };
+
+/* Builds, writes, renders and develops. L2P_BAD_INPUT naming --sampling pixel when the
+   tolerance is not above 0 or a sub-image would need more faces than pixels; POV-Ray's errors
+   as povray_render_chunks gives them. */
+int field_render(const camera *c, const field_render_options *o, l2p_error *err);
+
+#endif

@@ -1,0 +1,339 @@
+/* The adaptive mesh of one sub-image. Every pixel's exact ray is traced (the guarantee is
+   checked at every pixel, so nothing less would do); a quadtree of cells whose corners are
+   pixels is refined until, at every pixel a cell's two faces contain, the model of POV-Ray's
+   ray (povuv.c) is within the tolerance of the exact one, or until it reaches single pixels
+   where the lens blocks some corners. Pixels no face took get a tiny face of their own. */
+#include "field/subimage.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void field_tolerance_of(const camera *c, double pixels, field_tolerance *t)
+{
+    double pitch = c->film.width_mm / c->film.width;
+    double f = fabs(c->thick.rear_focal_length_mm);
+    double z = isfinite(c->focus_distance_units) ? c->focus_distance_units * c->unit_mm : INFINITY;
+    z = fmin(z, 100 * f);
+    t->pixels = pixels;
+    t->angle_rad = pixels * pitch / f;
+    t->origin_mm = pixels * pitch * z / f;
+}
+
+int field_render_size(int n)
+{
+    int p = 1;
+    while (p - 1 < n)
+        p *= 2;
+    return p - 1;
+}
+
+typedef struct builder {
+    const camera *c;
+    const field_tolerance *tol;
+    int w, h;
+    ray *rays;                 /* mesh space: camera space less the front vertex */
+    unsigned char *passed, *covered;
+    int *sum;                  /* (w+1) x (h+1) prefix sums of passed */
+    int *vid;                  /* mesh vertex of a pixel, -1 when none yet */
+    field_mesh *m;
+    field_stats *st;
+    float *weights;            /* the caller's, may be NULL */
+    bool oom;
+} builder;
+
+/* ---------------------------------------------------------------- tracing */
+
+static void trace_all(builder *b, film_sample s)
+{
+    const camera *c = b->c;
+    sample_batch *batch = malloc(sizeof *batch);
+    if (!batch) {
+        b->oom = true;
+        return;
+    }
+    const double front = c->lens.surface[0].vertex_z_mm;
+    const long n = (long)b->w * b->h;
+    for (long start = 0; start < n; start += CAMERA_BATCH) {
+        batch->n = (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH);
+        for (int k = 0; k < batch->n; k++) {
+            long i = start + k;
+            double rx = c->crop_x0 + i % b->w + s.offset_x, ry = c->crop_y0 + i / b->w + s.offset_y;
+            batch->film_point[k] = film_camera_from_raster(&c->film, rx, ry);
+            batch->u[k] = s.pupil_u;
+            batch->v[k] = s.pupil_v;
+        }
+        camera_trace_batch(c, batch);
+        for (int k = 0; k < batch->n; k++) {
+            ray r = batch->out[k];
+            long i = start + k;
+            vec3 fp = film_camera_from_raster(&c->film, c->crop_x0 + i % b->w + s.offset_x,
+                                              c->crop_y0 + i / b->w + s.offset_y);
+            /* as with pixel sampling, a film point beyond the lens's reach is no sample */
+            bool ok = batch->passed[k] && pupil_reaches(&c->pupil, fp) && v3_isfinite(r.o) &&
+                      v3_isfinite(r.d) && isfinite(batch->weight[k]);
+            r.o.z -= front;
+            b->rays[i] = r;
+            b->passed[i] = ok;
+            if (b->weights)
+                b->weights[i] = ok ? (float)batch->weight[k] : 0.0f;
+        }
+    }
+    free(batch);
+    for (int y = 0; y < b->h; y++)
+        for (int x = 0; x < b->w; x++)
+            b->sum[(y + 1) * (b->w + 1) + x + 1] = b->passed[y * b->w + x] + b->sum[y * (b->w + 1) + x + 1] +
+                                                   b->sum[(y + 1) * (b->w + 1) + x] - b->sum[y * (b->w + 1) + x];
+}
+
+/* Passing pixels in [x0, x1] x [y0, y1] (inclusive). */
+static long passing(const builder *b, int x0, int y0, int x1, int y1)
+{
+    const int W = b->w + 1;
+    return (long)b->sum[(y1 + 1) * W + x1 + 1] - b->sum[y0 * W + x1 + 1] - b->sum[(y1 + 1) * W + x0] + b->sum[y0 * W + x0];
+}
+
+/* ---------------------------------------------------------------- faces and checks */
+
+/* The face of three pixels as POV-Ray will hold it (float32 origins and directions). */
+static void pixel_face(const builder *b, const int px[3][2], povuv_face *f)
+{
+    double pos[3][3], nrm[3][3], uv[3][2];
+    for (int k = 0; k < 3; k++) {
+        const ray *r = &b->rays[px[k][1] * b->w + px[k][0]];
+        float p[3] = {(float)r->o.x, (float)r->o.y, (float)r->o.z}, n[3] = {(float)r->d.x, (float)r->d.y, (float)r->d.z};
+        for (int i = 0; i < 3; i++)
+            pos[k][i] = p[i], nrm[k][i] = n[i];
+        uv[k][0] = px[k][0] / (double)(b->m->render_w + 1);
+        uv[k][1] = 1.0 - (px[k][1] + 1) / (double)(b->m->render_h + 1);
+    }
+    povuv_face_init(f, pos, nrm, uv);
+}
+
+/* The error of the model's ray against the exact one, in units of the tolerance. */
+static double ray_error(const builder *b, const ray *exact, vec3 o, vec3 d)
+{
+    double angle = atan2(v3_length(v3_cross(exact->d, d)), v3_dot(exact->d, d));
+    vec3 e = v3_sub(o, exact->o);
+    vec3 across = v3_sub(e, v3_scale(exact->d, v3_dot(e, exact->d)));
+    return fmax(angle / b->tol->angle_rad, v3_length(across) / b->tol->origin_mm);
+}
+
+/* Whether pixel (x, y) is fine with face f: outside it, or inside with a ray within the
+   tolerance. */
+static bool pixel_ok(const builder *b, const povuv_face *f, int x, int y, double *worst)
+{
+    double u, v, w[3];
+    povuv_pixel_uv(b->m->render_w, b->m->render_h, x, y, &u, &v);
+    povuv_face_weights(f, u, v, w);
+    if (!(w[0] >= 0 && w[1] >= 0 && w[2] >= 0))
+        return true;
+    if (!b->passed[y * b->w + x])
+        return false;
+    vec3 o, d;
+    if (!povuv_face_ray(f, u, v, &o, &d))
+        return false;
+    double e = ray_error(b, &b->rays[y * b->w + x], o, d);
+    *worst = fmax(*worst, e);
+    return e <= 1.0;
+}
+
+static bool face_ok(const builder *b, const povuv_face *f, int x0, int y0, int x1, int y1, double *worst)
+{
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++)
+            if (!pixel_ok(b, f, x, y, worst))
+                return false;
+    return true;
+}
+
+static int vertex_of(builder *b, int x, int y)
+{
+    int *id = &b->vid[y * b->w + x];
+    if (*id < 0) {
+        const ray *r = &b->rays[y * b->w + x];
+        *id = field_mesh_vertex(b->m, r->o, r->d, x, y);
+        if (*id < 0)
+            b->oom = true;
+    }
+    return *id;
+}
+
+static void emit(builder *b, const int px[3][2], double worst)
+{
+    int a = vertex_of(b, px[0][0], px[0][1]), c = vertex_of(b, px[1][0], px[1][1]);
+    int d = vertex_of(b, px[2][0], px[2][1]);
+    if (a < 0 || c < 0 || d < 0 || field_mesh_face(b->m, a, c, d) < 0) {
+        b->oom = true;
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        b->covered[px[k][1] * b->w + px[k][0]] = 1;
+    b->st->worst_pixels = fmax(b->st->worst_pixels, worst * b->tol->pixels);
+}
+
+/* ---------------------------------------------------------------- the quadtree */
+
+/* A cell's two faces split along the diagonal from its top-right to its bottom-left corner. */
+static void cell_faces(int x0, int y0, int x1, int y1, int t[2][3][2])
+{
+    int a[2] = {x0, y0}, bb[2] = {x1, y0}, c[2] = {x0, y1}, d[2] = {x1, y1};
+    memcpy(t[0][0], a, sizeof a), memcpy(t[0][1], bb, sizeof bb), memcpy(t[0][2], c, sizeof c);
+    memcpy(t[1][0], bb, sizeof bb), memcpy(t[1][1], d, sizeof d), memcpy(t[1][2], c, sizeof c);
+}
+
+/* A whole passing cell: both faces, if every pixel they contain is within the tolerance. */
+static bool try_cell(builder *b, int x0, int y0, int x1, int y1)
+{
+    int t[2][3][2];
+    povuv_face f[2];
+    double worst = 0;
+    cell_faces(x0, y0, x1, y1, t);
+    for (int k = 0; k < 2; k++) {
+        pixel_face(b, (const int(*)[2])t[k], &f[k]);
+        if (!face_ok(b, &f[k], x0, y0, x1, y1, &worst))
+            return false;
+    }
+    for (int k = 0; k < 2; k++)
+        emit(b, (const int(*)[2])t[k], worst);
+    for (int y = y0; y <= y1; y++)
+        memset(b->covered + (size_t)y * b->w + x0, 1, (size_t)(x1 - x0 + 1));
+    return true;
+}
+
+/* A cell one pixel wide and high: each face of three passing corners whose pixels (its
+   corners) are within the tolerance, trying both diagonals. */
+static void finest(builder *b, int x0, int y0, int x1, int y1)
+{
+    const int corner[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    for (int skip = 0; skip < 4; skip++) {
+        int t[3][2], n = 0;
+        for (int k = 0; k < 4; k++)
+            if (k != skip)
+                memcpy(t[n++], corner[k], sizeof t[0]);
+        bool all = true, new_pixel = false;
+        for (int k = 0; k < 3; k++) {
+            all = all && b->passed[t[k][1] * b->w + t[k][0]];
+            new_pixel = new_pixel || !b->covered[t[k][1] * b->w + t[k][0]];
+        }
+        povuv_face f;
+        double worst = 0;
+        if (!all || !new_pixel)
+            continue;
+        pixel_face(b, (const int(*)[2])t, &f);
+        if (face_ok(b, &f, x0, y0, x1, y1, &worst))
+            emit(b, (const int(*)[2])t, worst);
+    }
+}
+
+static void build_cell(builder *b, int x0, int y0, int x1, int y1)
+{
+    if (b->oom || x1 <= x0 || y1 <= y0)
+        return;
+    long area = (long)(x1 - x0 + 1) * (y1 - y0 + 1), pass = passing(b, x0, y0, x1, y1);
+    if (pass == 0)
+        return;
+    if (pass == area && try_cell(b, x0, y0, x1, y1))
+        return;
+    bool sx = x1 - x0 >= 2, sy = y1 - y0 >= 2;
+    if (!sx && !sy) {
+        finest(b, x0, y0, x1, y1);
+        return;
+    }
+    int mx = sx ? (x0 + x1) / 2 : x1, my = sy ? (y0 + y1) / 2 : y1;
+    build_cell(b, x0, y0, mx, my);
+    if (sx)
+        build_cell(b, mx, y0, x1, my);
+    if (sy)
+        build_cell(b, x0, my, mx, y1);
+    if (sx && sy)
+        build_cell(b, mx, my, x1, y1);
+}
+
+/* ---------------------------------------------------------------- lone pixels */
+
+/* A passing pixel no face took (its neighbours are blocked, or no face through it was within
+   the tolerance): a small face of its own, a quarter pixel around its UV point so that it
+   contains no other pixel, whose UV centroid is the pixel. Its three origins sit
+   LONE_SPREAD_MM apart around the exact origin, across the ray (equal or collinear origins
+   leave POV-Ray's smoothing frame undefined), and all three carry the exact direction, so
+   that any weights give it back. */
+#define LONE_SPREAD_MM 0.01
+
+static void lone_face(builder *b, int x, int y)
+{
+    const ray *r = &b->rays[y * b->w + x];
+    vec3 side = fabs(r->d.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
+    vec3 e1 = v3_normalize(v3_cross(r->d, side)), e2 = v3_cross(r->d, e1);
+    const double c = -0.5, s = sqrt(3.0) / 2;
+    vec3 off[3] = {e1, v3_add(v3_scale(e1, c), v3_scale(e2, s)), v3_sub(v3_scale(e1, c), v3_scale(e2, s))};
+    const double dx[3] = {0.25, -0.125, -0.125}, dy[3] = {0, 0.25, -0.25};
+    int id[3];
+    for (int k = 0; k < 3; k++) {
+        id[k] = field_mesh_vertex(b->m, v3_madd(r->o, off[k], LONE_SPREAD_MM), r->d, x + dx[k], y + dy[k]);
+        if (id[k] < 0) {
+            b->oom = true;
+            return;
+        }
+    }
+    int f = field_mesh_face(b->m, id[0], id[1], id[2]);
+    if (f < 0) {
+        b->oom = true;
+        return;
+    }
+    povuv_face pf;
+    double worst = 0;
+    field_mesh_povuv_face(b->m, f, &pf);
+    if (!pixel_ok(b, &pf, x, y, &worst))
+        b->st->worst_pixels = INFINITY;   /* cannot happen: reported, and refused by the caller */
+    b->st->worst_pixels = fmax(b->st->worst_pixels, worst * b->tol->pixels);
+    b->covered[y * b->w + x] = 1;
+    b->st->lone_faces++;
+}
+
+/* ---------------------------------------------------------------- the sub-image */
+
+/* The coarsest cells: corners every base_cell pixels, and the last row and column. */
+static void build_grid(builder *b, int base)
+{
+    for (int y0 = 0; y0 < b->h - 1; y0 += base)
+        for (int x0 = 0; x0 < b->w - 1; x0 += base) {
+            int x1 = x0 + base < b->w - 1 ? x0 + base : b->w - 1;
+            int y1 = y0 + base < b->h - 1 ? y0 + base : b->h - 1;
+            build_cell(b, x0, y0, x1, y1);
+        }
+    for (int y = 0; y < b->h && !b->oom; y++)
+        for (int x = 0; x < b->w && !b->oom; x++)
+            if (b->passed[y * b->w + x] && !b->covered[y * b->w + x])
+                lone_face(b, x, y);
+}
+
+int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
+                         field_mesh *out, float *weights, field_stats *st, l2p_error *err)
+{
+    builder b = {.c = c, .tol = t, .w = c->crop_x1 - c->crop_x0, .h = c->crop_y1 - c->crop_y0,
+                 .m = out, .st = st, .weights = weights};
+    const size_t n = (size_t)b.w * b.h;
+    memset(st, 0, sizeof *st);
+    field_mesh_clear(out);
+    b.rays = malloc(n * sizeof *b.rays);
+    b.passed = calloc(n, 1);
+    b.covered = calloc(n, 1);
+    b.sum = calloc((size_t)(b.w + 1) * (b.h + 1), sizeof *b.sum);
+    b.vid = malloc(n * sizeof *b.vid);
+    b.oom = !b.rays || !b.passed || !b.covered || !b.sum || !b.vid;
+    if (!b.oom) {
+        memset(b.vid, 0xff, n * sizeof *b.vid);
+        trace_all(&b, s);
+    }
+    if (!b.oom)
+        build_grid(&b, base_cell < 1 ? 1 : base_cell);
+    for (size_t i = 0; i < n && !b.oom; i++)
+        st->passed += b.passed[i];
+    st->blocked = (long)n - st->passed;
+    st->faces = out->faces;
+    st->vertices = out->vertices;
+    free(b.rays), free(b.passed), free(b.covered), free(b.sum), free(b.vid);
+    if (b.oom)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory building a ray field");
+    return L2P_OK;
+}

@@ -1,0 +1,278 @@
+/* Ray fields (--sampling field): the shared sample set's stratification, and the adaptive
+   distribution-3 mesh of a sub-image read back through the model of POV-Ray
+   (src/field/povuv.c) against the exact traced rays. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "field/sobol.h"
+#include "support.h"
+
+/* ---------------------------------------------------------------- the sample set */
+
+static double dim_of(film_sample s, int d)
+{
+    return d == 0 ? s.offset_x : d == 1 ? s.offset_y : d == 2 ? s.pupil_u : s.pupil_v;
+}
+
+/* The first 2^m points put exactly one value in each interval [i/2^m, (i+1)/2^m) of every
+   dimension. */
+Test(field, shared_samples_are_stratified_in_each_dimension)
+{
+    for (uint64_t seed = 0; seed < 4; seed++)
+        for (int m = 0; m <= 10; m++) {
+            int n = 1 << m;
+            for (int d = 0; d < 4; d++) {
+                char *seen = calloc((size_t)n, 1);
+                for (int k = 0; k < n; k++) {
+                    double t = dim_of(sobol_shared_sample(seed, (uint32_t)k), d);
+                    cr_assert(t >= 0 && t < 1);
+                    int cell = (int)(t * n);
+                    cr_assert(!seen[cell], "seed %d, 2^%d points, dim %d: interval %d twice",
+                              (int)seed, m, d, cell);
+                    seen[cell] = 1;
+                }
+                free(seen);
+            }
+        }
+}
+
+/* The pixel offsets (dimensions 0 and 1) form a (0, m, 2)-net: for every split m = a + b,
+   each box of 2^-a x 2^-b holds exactly one of the first 2^m points. */
+Test(field, shared_pixel_offsets_form_a_0_m_2_net)
+{
+    for (uint64_t seed = 0; seed < 4; seed++)
+        for (int m = 0; m <= 10; m++)
+            for (int a = 0; a <= m; a++) {
+                int n = 1 << m, na = 1 << a, nb = 1 << (m - a);
+                char *seen = calloc((size_t)n, 1);
+                for (int k = 0; k < n; k++) {
+                    film_sample s = sobol_shared_sample(seed, (uint32_t)k);
+                    int box = (int)(s.offset_x * na) * nb + (int)(s.offset_y * nb);
+                    cr_assert(!seen[box], "seed %d, m %d, a %d: box %d twice", (int)seed, m, a, box);
+                    seen[box] = 1;
+                }
+                free(seen);
+            }
+}
+
+Test(field, seeds_scramble_the_samples)
+{
+    film_sample a = sobol_shared_sample(1, 3), b = sobol_shared_sample(2, 3);
+    cr_expect(a.offset_x != b.offset_x && a.pupil_u != b.pupil_u);
+    film_sample c = sobol_shared_sample(1, 3);
+    cr_expect(memcmp(&a, &c, sizeof a) == 0, "the same seed gives the same samples");
+}
+
+/* ---------------------------------------------------------------- a sub-image's mesh */
+
+#include <stdio.h>
+#include "field/subimage.h"
+
+/* The numbers after `key {`: a count, then count groups of n numbers in <...>. */
+static double *read_block(const char *text, const char *key, int n, int *count)
+{
+    const char *p = strstr(text, key);
+    cr_assert_not_null(p, "no %s", key);
+    p = strchr(p, '{') + 1;
+    *count = (int)strtol(p, (char **)&p, 10);
+    double *v = malloc(sizeof *v * (size_t)(*count * n + 1));
+    for (int i = 0; i < *count * n; i++) {
+        while (*p && !(*p == '-' || *p == '.' || (*p >= '0' && *p <= '9')))
+            p++;
+        v[i] = strtod(p, (char **)&p);
+    }
+    return v;
+}
+
+/* The include as POV-Ray reads it, through the model. */
+static void read_include(const char *text, povuv_mesh *pm)
+{
+    int nv, nn, nu, nf;
+    double *pos = read_block(text, "vertex_vectors", 3, &nv), *nrm = read_block(text, "normal_vectors", 3, &nn);
+    double *uv = read_block(text, "uv_vectors", 2, &nu), *tri = read_block(text, "face_indices", 3, &nf);
+    cr_assert(nv == nn && nv == nu);
+    povuv_face *faces = malloc(sizeof *faces * (size_t)(nf + 1));
+    for (int k = 0; k < nf; k++) {
+        double p[3][3], n[3][3], t[3][2];
+        for (int j = 0; j < 3; j++) {
+            int i = (int)tri[3 * k + j];
+            cr_assert(i >= 0 && i < nv);
+            memcpy(p[j], pos + 3 * i, sizeof p[j]), memcpy(n[j], nrm + 3 * i, sizeof n[j]);
+            memcpy(t[j], uv + 2 * i, sizeof t[j]);
+        }
+        povuv_face_init(&faces[k], p, n, t);
+    }
+    cr_assert_eq(povuv_mesh_init(pm, faces, nf), 0);
+    free(pos), free(nrm), free(uv), free(tri);
+}
+
+/* Builds the sub-image of shared sample k, writes its include, reads it back through the
+   model, and checks every pixel of the crop against its exact traced ray. */
+static void check_subimage(const char *lens, camera_options *o, double tol, uint32_t k, field_stats *st)
+{
+    camera c;
+    test_camera(&c, lens, o);
+    field_tolerance t;
+    field_tolerance_of(&c, tol, &t);
+    const int w = c.crop_x1 - c.crop_x0, h = c.crop_y1 - c.crop_y0;
+    film_sample s = sobol_shared_sample(o->seed, k);
+    field_mesh m;
+    field_mesh_init(&m, field_render_size(w), field_render_size(h));
+    l2p_error err;
+    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_BASE_CELL, &m, NULL, st, &err), L2P_OK, "%s", err.text);
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Test", world), 0);
+    fclose(f);
+    povuv_mesh pm;
+    read_include(text, &pm);
+    const double front = c.lens.surface[0].vertex_z_mm;
+    long rendered = 0, passed = 0;
+    double worst = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            vec3 fp = film_camera_from_raster(&c.film, c.crop_x0 + x + s.offset_x, c.crop_y0 + y + s.offset_y);
+            ray r;
+            double weight;
+            bool pass = pupil_reaches(&c.pupil, fp) && camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &weight);
+            double u, v;
+            povuv_pixel_uv(m.render_w, m.render_h, x, y, &u, &v);
+            int face = povuv_mesh_find(&pm, u, v);
+            cr_assert_eq(face >= 0, pass, "%s pixel %d,%d: rendered %d, passes %d", lens, x, y, face >= 0, pass);
+            passed += pass;
+            if (face < 0)
+                continue;
+            rendered++;
+            r.o.z -= front;
+            {
+                vec3 mo, md;
+                cr_assert(povuv_face_ray(&pm.face[face], u, v, &mo, &md));
+                double angle = atan2(v3_length(v3_cross(r.d, md)), v3_dot(r.d, md));
+                vec3 e = v3_sub(mo, r.o);
+                double across = v3_length(v3_sub(e, v3_scale(r.d, v3_dot(e, r.d))));
+                double err_px = fmax(angle / t.angle_rad, across / t.origin_mm) * tol;
+                cr_assert(err_px <= tol, "%s pixel %d,%d: error %g px", lens, x, y, err_px);
+                worst = fmax(worst, err_px);
+            }
+        }
+    cr_log_info("%s %dx%d f/%g: %d faces (%d lone), %ld of %ld pixels pass, worst %.3g px (tolerance %g)",
+                lens, w, h, c.f_number, st->faces, st->lone_faces, passed, (long)w * h, worst, tol);
+    cr_expect_eq(passed, st->passed);
+    cr_expect(rendered == passed);
+    free(text);
+    povuv_mesh_free(&pm);
+    field_mesh_free(&m);
+    camera_free(&c);
+}
+
+static camera_options small(int w, int h)
+{
+    camera_options o;
+    camera_options_default(&o);
+    o.width = w, o.height = h, o.spp = 1, o.seed = 7;
+    o.location = v3(0, 1, -4), o.look_at = v3(0, 1, 0);
+    return o;
+}
+
+Test(field, dgauss_full_aperture_every_pixel_within_the_tolerance)
+{
+    camera_options o = small(160, 120);
+    field_stats st;
+    for (uint32_t k = 0; k < 2; k++)
+        check_subimage("dgauss.50mm", &o, 0.05, k, &st);
+}
+
+Test(field, dgauss_stopped_down_every_pixel_within_the_tolerance)
+{
+    camera_options o = small(160, 120);
+    o.f_number = 8;
+    field_stats st;
+    check_subimage("dgauss.50mm", &o, 0.05, 1, &st);
+}
+
+Test(field, fisheye_every_pixel_within_the_tolerance)
+{
+    camera_options o = small(160, 120);
+    field_stats st;
+    for (uint32_t k = 0; k < 2; k++)
+        check_subimage("fisheye.10mm", &o, 0.05, k, &st);
+    cr_expect(st.blocked > 0, "the fisheye's image circle blocks the corners");
+}
+
+Test(field, a_crop_every_pixel_within_the_tolerance)
+{
+    camera_options o = small(320, 240);
+    o.crop_x0 = 200, o.crop_y0 = 150, o.crop_x1 = 300, o.crop_y1 = 230;
+    field_stats st;
+    check_subimage("wide.22mm", &o, 0.05, 3, &st);
+    check_subimage("fisheye.10mm", &o, 0.05, 2, &st);
+}
+
+/* Two sub-images moved side by side into one render (as field_render.c packs them): read back
+   through the model, every pixel of each still gets its exact ray within the tolerance, and
+   the pixels between and beyond them none. */
+Test(field, sub_images_moved_into_a_render_keep_their_rays)
+{
+    camera_options o = small(120, 90);
+    camera c;
+    test_camera(&c, "fisheye.10mm", &o);
+    field_tolerance t;
+    field_tolerance_of(&c, 0.05, &t);
+    const int w = 120, h = 90, rw = field_render_size(2 * w + 7), rh = field_render_size(h);
+    field_mesh render;
+    field_mesh_init(&render, rw, rh);
+    const int dx[2] = {0, w + 7};
+    for (int k = 0; k < 2; k++) {
+        field_mesh m;
+        field_stats st;
+        l2p_error err;
+        field_mesh_init(&m, field_render_size(w), field_render_size(h));
+        cr_assert_eq(field_build_subimage(&c, sobol_shared_sample(o.seed, (uint32_t)k), &t, FIELD_BASE_CELL,
+                                          &m, NULL, &st, &err), L2P_OK);
+        cr_assert_eq(field_mesh_append(&render, &m, dx[k], 0), 0);
+        field_mesh_free(&m);
+    }
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    cr_assert_eq(field_mesh_write_include(f, &render, "Field_Test", world), 0);
+    fclose(f);
+    povuv_mesh pm;
+    read_include(text, &pm);
+    const double front = c.lens.surface[0].vertex_z_mm;
+    for (int y = 0; y < rh; y++)
+        for (int x = 0; x < rw; x++) {
+            double u, v;
+            povuv_pixel_uv(rw, rh, x, y, &u, &v);
+            int face = povuv_mesh_find(&pm, u, v);
+            int k = x < w ? 0 : x >= dx[1] && x < dx[1] + w ? 1 : -1;
+            if (k < 0 || y >= h) {
+                cr_assert(face < 0, "pixel %d,%d outside the sub-images is traced", x, y);
+                continue;
+            }
+            film_sample s = sobol_shared_sample(o.seed, (uint32_t)k);
+            vec3 fp = film_camera_from_raster(&c.film, x - dx[k] + s.offset_x, y + s.offset_y);
+            ray r;
+            double weight;
+            bool pass = pupil_reaches(&c.pupil, fp) && camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &weight);
+            cr_assert_eq(face >= 0, pass, "pixel %d,%d: rendered %d, passes %d", x, y, face >= 0, pass);
+            if (face < 0)
+                continue;
+            vec3 mo, md;
+            cr_assert(povuv_face_ray(&pm.face[face], u, v, &mo, &md));
+            r.o.z -= front;
+            double angle = atan2(v3_length(v3_cross(r.d, md)), v3_dot(r.d, md));
+            vec3 e = v3_sub(mo, r.o);
+            double across = v3_length(v3_sub(e, v3_scale(r.d, v3_dot(e, r.d))));
+            cr_assert(angle <= t.angle_rad && across <= t.origin_mm, "pixel %d,%d: %g rad, %g mm", x, y,
+                      angle, across);
+        }
+    free(text);
+    povuv_mesh_free(&pm);
+    field_mesh_free(&render);
+    camera_free(&c);
+}

@@ -1,0 +1,121 @@
+/* render --sampling field through the real POV-Ray: refusals, and a field render agreeing with
+   a pixel render of a scene with edges within the noise of two pixel renders. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "image/image_io.h"
+#include "support.h"
+
+#define L2P(out, errtext, ...) run_lens2pov(out, errtext, __VA_ARGS__, (char *)NULL)
+
+/* Edges everywhere: a checker floor, a sphere against a sky gradient, one light. */
+static const char *SCENE =
+    "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+    "camera { location <0, 1, -4> look_at <0, 0.6, 0> }\n"
+    "light_source { <-3, 5, -4> rgb 1 }\n"
+    "sky_sphere { pigment { gradient y color_map { [0 rgb <0.6,0.7,0.9>] [1 rgb <0.1,0.2,0.6>] } } }\n"
+    "plane { y, 0 pigment { checker rgb 0.9 rgb 0.1 scale 0.5 } finish { ambient 0.2 diffuse 0.8 } }\n"
+    "sphere { <0.3, 0.8, 0.5>, 0.8 pigment { rgb <0.8, 0.2, 0.1> } finish { ambient 0.2 diffuse 0.8 } }\n";
+
+static float *render(const char *dir, const char *name, const char *sampling, const char *seed)
+{
+    const char *scene = tmp_path(dir, "scene.pov");
+    char out[4096];
+    snprintf(out, sizeof out, "%s/%s.exr", dir, name);
+    char *errtext = NULL;
+    int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "48",
+                 "--height", "36", "--spp", "16", "--f-number", "2.8", "--seed", seed, "--sampling",
+                 sampling, "--jobs", "2", "--quiet", "-o", out);
+    cr_assert_eq(st, 0, "render %s: %s", name, errtext ? errtext : "");
+    free(errtext);
+    int w, h;
+    float *px;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(out, &w, &h, &px, &err), 0, "%s", err.text);
+    cr_assert(w == 48 && h == 36);
+    return px;
+}
+
+static double mean_abs_difference(const float *a, const float *b)
+{
+    double sum = 0;
+    for (int i = 0; i < 48 * 36; i++)
+        for (int c = 0; c < 3; c++)
+            sum += fabs(a[4 * i + c] - b[4 * i + c]);
+    return sum / (48 * 36 * 3);
+}
+
+static double mean(const float *a)
+{
+    double sum = 0;
+    for (int i = 0; i < 48 * 36; i++)
+        sum += a[4 * i] + a[4 * i + 1] + a[4 * i + 2];
+    return sum / (48 * 36 * 3);
+}
+
+Test(field_render, agrees_with_pixel_sampling_within_the_noise)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    float *p1 = render(dir, "pixel1", "pixel", "1"), *p2 = render(dir, "pixel2", "pixel", "2");
+    float *f1 = render(dir, "field1", "field", "1");
+    double noise = mean_abs_difference(p1, p2), diff = mean_abs_difference(f1, p1);
+    cr_log_info("field against pixel %.4f, pixel against pixel %.4f; means %.4f %.4f", diff, noise,
+                mean(f1), mean(p1));
+    cr_expect(diff < 1.5 * noise + 2e-3, "field %g, noise %g", diff, noise);
+    cr_expect(fabs(mean(f1) - mean(p1)) < 0.02 * mean(p1));
+    free(p1), free(p2), free(f1);
+}
+
+Test(field_render, refuses_a_tolerance_it_cannot_keep)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *scene = tmp_path(dir, "scene.pov");
+    static const char *const bad[] = {"0", "-1", "1e-9"};
+    for (int i = 0; i < 3; i++) {
+        char *errtext = NULL;
+        int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "16",
+                     "--height", "12", "--spp", "1", "--sampling", "field", "--field-tolerance", bad[i],
+                     "--quiet", "-o", tmp_path(dir, "x.png"));
+        cr_expect_eq(st, 2, "--field-tolerance %s: status %d", bad[i], st);
+        cr_expect(errtext && strstr(errtext, "--sampling pixel"), "--field-tolerance %s: %s", bad[i],
+                  errtext ? errtext : "");
+        free(errtext);
+    }
+    char *errtext = NULL;
+    cr_expect_eq(L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--sampling",
+                     "rays", "-o", tmp_path(dir, "x.png")), 2);
+    free(errtext);
+    cr_expect(!file_exists(tmp_path(dir, "x.png")));
+}
+
+/* How sub-images are packed into renders (here: one render of 4 with one job, two of 2 with
+   two) changes no pixel: every UV is a short binary fraction, so every pixel gets the same
+   face weights, hence the same ray, in any render. A crop is the crop's size. */
+Test(field_render, packing_changes_no_pixel)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    char scene[1024], out[2][1024];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    for (int j = 0; j < 2; j++) {
+        snprintf(out[j], sizeof out[j], "%s/jobs%d.exr", dir, j + 1);
+        char *errtext = NULL;
+        int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "fisheye.10mm.dat", "--width", "64",
+                     "--height", "48", "--crop", "8,4,58,40", "--spp", "4", "--sampling", "field",
+                     "--jobs", j ? "2" : "1", "--quiet", "-o", out[j]);
+        cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+        free(errtext);
+    }
+    int w[2], h[2];
+    float *px[2];
+    l2p_error err;
+    for (int j = 0; j < 2; j++)
+        cr_assert_eq(image_read_rgba(out[j], &w[j], &h[j], &px[j], &err), 0, "%s", err.text);
+    cr_assert(w[0] == 50 && h[0] == 36 && w[1] == 50 && h[1] == 36);
+    cr_expect(memcmp(px[0], px[1], sizeof(float) * 4 * 50 * 36) == 0, "the two packings differ");
+    free(px[0]), free(px[1]);
+}
