@@ -29,7 +29,7 @@ IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbo
                  -Wl,--export-dynamic-symbol=outfile_create_temp
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
-               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core
+               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core libxml2-utils
 
 # The sources, one folder per stage of the data flow (docs/source.md).
 LIB_C   = $(filter-out src/cli/main.c,$(wildcard src/*/*.c))

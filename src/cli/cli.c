@@ -15,13 +15,14 @@
 #define FILM_PIXELS_MOST 4294967296LL
 
 /* The commands, as bits of the option table. */
-enum { CMD_INFO = 1, CMD_TRACE = 2, CMD_DEVELOP = 4, CMD_RENDER = 8 };
-enum { CMD_CAMERA = CMD_INFO | CMD_TRACE | CMD_RENDER, CMD_SAMPLES = CMD_TRACE | CMD_RENDER };
+enum { CMD_INFO = 1, CMD_TRACE = 2, CMD_DEVELOP = 4, CMD_RENDER = 8, CMD_DIAGRAM = 16 };
+enum { CMD_CAMERA = CMD_INFO | CMD_TRACE | CMD_RENDER | CMD_DIAGRAM,
+       CMD_SAMPLES = CMD_TRACE | CMD_RENDER };
 
 static unsigned command_bit(const char *name)
 {
-    static const char *const names[] = {"info", "trace", "develop", "render"};
-    for (unsigned i = 0; i < 4; i++)
+    static const char *const names[] = {"info", "trace", "develop", "render", "diagram"};
+    for (unsigned i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcmp(name, names[i]))
             return 1u << i;
     return 0;
@@ -48,6 +49,8 @@ static const cli_option OPTIONS[] = {
      "  -o, --output IMAGE            (required)\n"},
     {"--output", "-o", CMD_RENDER, false, false,
      "  -o, --output IMAGE            .png, .exr or .tif (required)\n"},
+    {"--output", "-o", CMD_DIAGRAM, false, false,
+     "  -o, --output FILE.svg         (required)\n"},
     {"--jobs", NULL, CMD_RENDER, false, false,
      "  --jobs N                      POV-Ray processes at once [the cores]\n"},
     {"--memory-mb", NULL, CMD_TRACE, false, false,

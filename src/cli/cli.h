@@ -32,7 +32,7 @@ typedef struct cli {
     int povray_arg_count;
 } cli;
 
-/* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render): an
+/* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render, diagram): an
    option that command does not take is refused, naming both. */
 int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
 
