@@ -144,3 +144,95 @@ Test(diagram, bad_requests_exit_2)
     cr_assert_eq(run_lens2pov(NULL, &err, "diagram", "dgauss.50mm", "--spp", "4", "-o", svg, NULL), 2);
     free(err);
 }
+
+/* ---- plot */
+
+/* The PNG signature and the IHDR chunk's width and height (big-endian, bytes 16-23). */
+static void check_png_size(const char *path, unsigned width, unsigned height)
+{
+    size_t n;
+    unsigned char *png = (unsigned char *)read_text(path, &n);
+    cr_assert(png && n > 24, "no PNG %s", path);
+    cr_assert(!memcmp(png, "\x89PNG\r\n\x1a\n", 8) && !memcmp(png + 12, "IHDR", 4));
+    const unsigned w = (unsigned)png[16] << 24 | png[17] << 16 | png[18] << 8 | png[19];
+    const unsigned h = (unsigned)png[20] << 24 | png[21] << 16 | png[22] << 8 | png[23];
+    cr_assert(w == width && h == height, "%ux%u, expected %ux%u", w, h, width, height);
+    free(png);
+}
+
+/* The table plot prints: rows of numbers after the comment lines. */
+static int read_table(const char *text, double rows[][5], int columns)
+{
+    int n = 0;
+    for (const char *line = text; line && *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
+        if (*line == '#' || *line == '\n')
+            continue;
+        const char *p = line;
+        for (int k = 0; k < columns; k++) {
+            char *end;
+            rows[n][k] = strtod(p, &end);
+            cr_assert(end != p, "a short row: %.40s", line);
+            p = end;
+        }
+        n++;
+    }
+    return n;
+}
+
+/* The double-Gauss at full aperture: E(0)/E(0) is 1, and the light falls toward the corner
+   (the table's grid measures to a few 1e-4, the fall is far larger). */
+Test(plot, vignetting_falls_from_1_toward_the_corner)
+{
+    const char *png = tmp_path(test_tmpdir(), "v.png");
+    char *out = NULL;
+    cr_assert_eq(run_lens2pov(&out, NULL, "plot", "dgauss.50mm", "--what", "vignetting", "-o", png, NULL), 0);
+    check_png_size(png, 800, 500);
+    double rows[64][5];
+    const int n = read_table(out, rows, 5);   /* radius, full, f/4, f/8, f/16 */
+    cr_assert_eq(n, 25);
+    cr_assert_eq(rows[0][0], 0.0);
+    for (int k = 1; k < 5; k++)
+        cr_assert_eq(rows[0][k], 1.0);
+    for (int i = 1; i < n; i++)
+        cr_assert_lt(rows[i][1], rows[i - 1][1] + 1e-3, "full aperture, row %d", i);
+    cr_assert_lt(rows[n - 1][1], 0.8 * rows[n - 1][4], "wide open vignettes more than f/16");
+    free(out);
+}
+
+Test(plot, distortion_is_0_on_the_axis)
+{
+    const char *png = tmp_path(test_tmpdir(), "d.png");
+    char *out = NULL;
+    cr_assert_eq(run_lens2pov(&out, NULL, "plot", "dgauss.50mm", "--what", "distortion", "-o", png, NULL), 0);
+    check_png_size(png, 800, 500);
+    double rows[64][5];
+    const int n = read_table(out, rows, 4);   /* radius, angle, paraxial height, distortion */
+    cr_assert_eq(n, 25);
+    cr_assert_eq(rows[0][3], 0.0);
+    cr_assert(fabs(rows[1][3]) < 0.1, "near the axis %g%%", rows[1][3]);
+    free(out);
+}
+
+Test(plot, bad_requests_exit_2_and_a_missing_gnuplot_1)
+{
+    const char *dir = test_tmpdir();
+    const char *png = tmp_path(dir, "x.png");
+    char *err = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &err, "plot", "dgauss.50mm", "--what", "mtf", "-o", png, NULL), 2);
+    cr_assert(strstr(err, "mtf"), "%s", err);
+    free(err);
+    cr_assert_eq(run_lens2pov(NULL, &err, "plot", "dgauss.50mm", "-o", png, NULL), 2);
+    cr_assert(strstr(err, "--what"), "%s", err);
+    free(err);
+    cr_assert_eq(run_lens2pov(NULL, &err, "plot", "dgauss.50mm", "--what", "distortion", NULL), 2);
+    free(err);
+    cr_assert_eq(run_lens2pov(NULL, &err, "plot", "telephoto.250mm", "--what", "distortion", "-o", png, NULL), 2);
+    free(err);
+    cr_assert_eq(run_lens2pov(NULL, &err, "diagram", "dgauss.50mm", "--what", "distortion", "-o", png, NULL), 2);
+    free(err);
+    setenv("PATH", "/nonexistent", 1);
+    cr_assert_eq(run_lens2pov(NULL, &err, "plot", "dgauss.50mm", "--what", "distortion", "-o", png, NULL), 1);
+    cr_assert(strstr(err, "gnuplot"), "%s", err);
+    free(err);
+    cr_assert_not(file_exists(png));
+}
