@@ -134,7 +134,7 @@ install: $(BUILD)/lens2pov
 	install -m 644 docs/lens2pov.1 $(DESTDIR)$(PREFIX)/share/man/man1/lens2pov.1
 	install -m 644 README.md $(DESTDIR)$(PREFIX)/share/doc/lens2pov
 	install -m 644 examples/README.md $(DESTDIR)$(PREFIX)/share/doc/lens2pov/examples
-	install -m 644 docs/*.md docs/*.png $(DESTDIR)$(PREFIX)/share/doc/lens2pov/docs
+	install -m 644 docs/*.md docs/*.png docs/*.svg $(DESTDIR)$(PREFIX)/share/doc/lens2pov/docs
 	install -m 644 $(IMAGE_IO_SO) $(DESTDIR)$(PREFIX)/lib/lens2pov/lens2pov-image-io.so
 	install -m 644 lenses/*.dat $(DESTDIR)$(PREFIX)/share/lens2pov/lenses
 	install -m 644 pov/* $(DESTDIR)$(PREFIX)/share/lens2pov/pov
