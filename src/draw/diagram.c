@@ -191,10 +191,15 @@ static void draw_labels(FILE *out, const scene *s)
     svg_text(out, "label", svg_x(v, l->surface[l->stop].vertex_z_mm),
              svg_y(v, fmax(a, big) + 0.1 * v->ymax) - 4.0, "stop");
     svg_text(out, "label", svg_x(v, 0.0), svg_y(v, 0.5 * s->c->film.diagonal_mm) - 4.0, "film");
-    char title[512];
-    snprintf(title, sizeof title, "%s: f/%.3g, focus %s%.4g units, film %.4g mm from the rear vertex",
-             l->name, s->c->f_number, isfinite(s->c->focus_distance_units) ? "" : "at ",
-             s->c->focus_distance_units, l->film_distance_mm);
+    char title[512], focus[64];
+    /* Focused at infinity, the film distance is the rear focal one to rounding, and the
+       conjugate it gives is some 1e12 film distances away, of either sign. */
+    if (fabs(s->c->focus_distance_units * s->c->unit_mm) < 1e6 * l->film_distance_mm)
+        snprintf(focus, sizeof focus, "%.4g units", s->c->focus_distance_units);
+    else
+        snprintf(focus, sizeof focus, "infinity");
+    snprintf(title, sizeof title, "%s: f/%.3g, focus at %s, film %.4g mm from the rear vertex",
+             l->name, s->c->f_number, focus, l->film_distance_mm);
     svg_text(out, "title", v->margin_px, 20.0, title);
 }
 

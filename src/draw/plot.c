@@ -47,8 +47,11 @@ void plot_distortion_table(FILE *out, const camera *c)
         if (!chief_angle(c, r, &theta))
             continue;   /* beyond a fisheye's image circle */
         /* At 90 degrees and beyond tan(theta) no longer grows: no paraxial height. */
-        const double h = theta < 0.5 * M_PI ? k * tan(theta) : NAN;
-        fprintf(out, "%.9g %.9g %.9g %.9g\n", r, theta * 180.0 / M_PI, h, 100.0 * (r / h - 1.0));
+        if (theta < 0.5 * M_PI)
+            fprintf(out, "%.9g %.9g %.9g %.9g\n", r, theta * 180.0 / M_PI, k * tan(theta),
+                    100.0 * (r / (k * tan(theta)) - 1.0));
+        else   /* gnuplot reads NaN as a missing value */
+            fprintf(out, "%.9g %.9g NaN NaN\n", r, theta * 180.0 / M_PI);
     }
 }
 
