@@ -29,7 +29,7 @@ IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbo
                  -Wl,--export-dynamic-symbol=outfile_create_temp
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
-               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core
+               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core libxml2-utils
 
 # The sources, one folder per stage of the data flow (docs/source.md).
 LIB_C   = $(filter-out src/cli/main.c,$(wildcard src/*/*.c))
@@ -134,7 +134,7 @@ install: $(BUILD)/lens2pov
 	install -m 644 docs/lens2pov.1 $(DESTDIR)$(PREFIX)/share/man/man1/lens2pov.1
 	install -m 644 README.md $(DESTDIR)$(PREFIX)/share/doc/lens2pov
 	install -m 644 examples/README.md $(DESTDIR)$(PREFIX)/share/doc/lens2pov/examples
-	install -m 644 docs/*.md docs/*.png $(DESTDIR)$(PREFIX)/share/doc/lens2pov/docs
+	install -m 644 docs/*.md docs/*.png docs/*.svg $(DESTDIR)$(PREFIX)/share/doc/lens2pov/docs
 	install -m 644 $(IMAGE_IO_SO) $(DESTDIR)$(PREFIX)/lib/lens2pov/lens2pov-image-io.so
 	install -m 644 lenses/*.dat $(DESTDIR)$(PREFIX)/share/lens2pov/lenses
 	install -m 644 pov/* $(DESTDIR)$(PREFIX)/share/lens2pov/pov

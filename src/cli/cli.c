@@ -15,13 +15,15 @@
 #define FILM_PIXELS_MOST 4294967296LL
 
 /* The commands, as bits of the option table. */
-enum { CMD_INFO = 1, CMD_TRACE = 2, CMD_DEVELOP = 4, CMD_RENDER = 8 };
-enum { CMD_CAMERA = CMD_INFO | CMD_TRACE | CMD_RENDER, CMD_SAMPLES = CMD_TRACE | CMD_RENDER };
+enum { CMD_INFO = 1, CMD_TRACE = 2, CMD_DEVELOP = 4, CMD_RENDER = 8, CMD_DIAGRAM = 16,
+       CMD_PLOT = 32 };
+enum { CMD_CAMERA = CMD_INFO | CMD_TRACE | CMD_RENDER | CMD_DIAGRAM | CMD_PLOT,
+       CMD_SAMPLES = CMD_TRACE | CMD_RENDER };
 
 static unsigned command_bit(const char *name)
 {
-    static const char *const names[] = {"info", "trace", "develop", "render"};
-    for (unsigned i = 0; i < 4; i++)
+    static const char *const names[] = {"info", "trace", "develop", "render", "diagram", "plot"};
+    for (unsigned i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcmp(name, names[i]))
             return 1u << i;
     return 0;
@@ -48,6 +50,12 @@ static const cli_option OPTIONS[] = {
      "  -o, --output IMAGE            (required)\n"},
     {"--output", "-o", CMD_RENDER, false, false,
      "  -o, --output IMAGE            .png, .exr or .tif (required)\n"},
+    {"--output", "-o", CMD_DIAGRAM, false, false,
+     "  -o, --output FILE.svg         (required)\n"},
+    {"--output", "-o", CMD_PLOT, false, false,
+     "  -o, --output FILE.png         (required)\n"},
+    {"--what", NULL, CMD_PLOT, false, false,
+     "  --what distortion|vignetting  (required)\n"},
     {"--jobs", NULL, CMD_RENDER, false, false,
      "  --jobs N                      POV-Ray processes at once [the cores]\n"},
     {"--memory-mb", NULL, CMD_TRACE, false, false,
@@ -237,7 +245,10 @@ static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
     } else if (!strcmp(opt, "--field-tolerance")) {
         if (!value_double(v, &c->field_tolerance) || !(c->field_tolerance > 0))
             return value_bad(err, opt, "pixels above 0 (for exact rays: --sampling pixel)", v);
-    } else if (!strcmp(opt, "--jobs"))   /* outfile.c stops at most 256 children on a signal */
+    } else if (!strcmp(opt, "--what")) {   /* plot: the command checks the name */
+        c->what = v;
+        return L2P_OK;
+    } else if (!strcmp(opt, "--jobs"))   /* cleanup.c stops at most 256 children on a signal */
         return value_int_up_to(opt, v, JOBS_MOST, &c->jobs, err);
     else if (!strcmp(opt, "--memory-mb"))  /* up to 1 PiB: render converts it to a face count */
         return value_positive_double(opt, v, &c->memory_mb, err) ? L2P_BAD_INPUT

@@ -24,6 +24,7 @@ typedef struct cli {
     bool no_size_check;          /* --no-size-check: trace even what seems not to fit */
     bool film_given;             /* a camera option was given (info prints the camera) */
     bool placed;                 /* --location, --look-at or --sky: the scene's camera is not used */
+    const char *what;            /* plot --what: distortion or vignetting */
     const char *scene;           /* trace --scene: the scene whose camera places the lens */
     double angle_deg;            /* --angle: the horizontal field of view; NAN: not given */
     bool angle_scene;            /* --angle scene: the scene camera's */
@@ -34,7 +35,7 @@ typedef struct cli {
     double field_tolerance;      /* --field-tolerance, pixels [0.05] */
 } cli;
 
-/* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render): an
+/* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render, diagram, plot): an
    option that command does not take is refused, naming both. */
 int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
 

@@ -15,6 +15,8 @@ static const char usage[] =
     "  lens2pov develop PREFIX [RENDER.exr ...] -o IMAGE   (.png, .exr or .tif)\n"
     "  lens2pov render SCENE.pov LENS [camera options] -o IMAGE [--jobs N] [--keep-temp DIR]\n"
     "                  [-- POV-Ray options: +KFI1 +KFF10, Declare=N=V, +L, FILE.ini, ...]\n"
+    "  lens2pov diagram LENS [camera options] -o FILE.svg\n"
+    "  lens2pov plot LENS --what distortion|vignetting [camera options] -o FILE.png\n"
     "  lens2pov COMMAND --help      (its options and their defaults)\n"
     "  lens2pov --version\n"
     "See README.md and docs/ for the conventions.\n";
@@ -36,6 +38,14 @@ static const struct {
                "  -- OPTIONS                    POV-Ray's own, for every run: animation (+KFI, +KFF,\n"
                "                                +KI, +KF, +KC, +K), Declare=, +L, +Q, FILE.ini;\n"
                "                                an animation gives IMAGE01.png, IMAGE02.png, ...\n"},
+    {"diagram", "usage: lens2pov diagram LENS [camera options] -o FILE.svg\n"
+                "The lens in its meridional section, to scale: elements, stop, film, rays from\n"
+                "the film's centre and edge traced through every surface, principal planes,\n"
+                "focal points and pupils (full simulation, at the focus and aperture given).\n"},
+    {"plot", "usage: lens2pov plot LENS --what distortion|vignetting [camera options] -o FILE.png\n"
+             "A gnuplot chart against film radius: distortion, the chief ray's image height\n"
+             "against the paraxial one (percent); vignetting, the relative illumination\n"
+             "E(r)/E(0) at full aperture, f/4, f/8 and f/16. The table goes to stdout.\n"},
 };
 
 /* lens2pov COMMAND ... --help (or -h anywhere after the command): true when printed. */
@@ -90,6 +100,10 @@ int main(int argc, char **argv)
         st = develop_command(&c, &err);
     else if (!strcmp(cmd, "render"))
         st = render_command(&c, &err);
+    else if (!strcmp(cmd, "diagram"))
+        st = diagram_command(&c, &err);
+    else if (!strcmp(cmd, "plot"))
+        st = plot_command(&c, &err);
     else
         st = l2p_fail(&err, L2P_BAD_INPUT, NULL, 0, "unknown command '%s' (see --help)", cmd);
     return st ? fail(&err) : L2P_OK;

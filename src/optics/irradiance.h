@@ -1,0 +1,16 @@
+/* The film irradiance a uniform background gives, measured with the full simulation alone,
+   without the pupils: what the relative illumination (vignetting) of a lens is. */
+#ifndef LENS2POV_IRRADIANCE_H
+#define LENS2POV_IRRADIANCE_H
+
+#include "optics/lens.h"
+#include "base/vec3.h"
+
+/* E at film point p for a background of radiance 1: the integral of cos(theta) over the
+   directions the lens passes from p, which is the area of the passing set in the plane of
+   direction cosines (a, b), since d(omega) cos(theta) = da db. A 128 x 128 grid over the unit
+   square finds the set; an n x n grid over its bounding box (grown by two coarse cells)
+   measures it. 0 when no direction passes. */
+double irradiance_at(const lens *l, vec3 p, int n);
+
+#endif
