@@ -184,7 +184,7 @@ Test(emit, focus_puts_the_film_centre_conjugate_at_the_focus_distance)
                 camera_free(&c);
                 continue;
             }
-            const double h = 1e-6 * c.lens.surface[c.lens.count - 1].aperture_mm;
+            const double h = 1e-6 * c.lens.surface[c.lens.count - 1].aperture_diameter_mm;
             ray r = {v3(0, 0, 0), v3_normalize(v3(0, h / c.lens.film_distance_mm, 1))};
             cr_assert_eq(trace_toward_scene(&c.lens, 0, c.lens.count - 1, &r, NULL), TRACE_PASSED);
             const double z = r.o.z - r.o.y * r.d.z / r.d.y;
@@ -282,7 +282,7 @@ Test(emit, the_widest_f_number_as_printed_opens_the_stop_fully)
     camera_for("dgauss.50mm", "stop-image", &full);
     char printed[32];
     snprintf(printed, sizeof printed, "%.4g", full.f_number);
-    const double stop_mm = full.lens.surface[full.lens.stop].aperture_mm;
+    const double stop_mm = full.lens.surface[full.lens.stop].aperture_diameter_mm;
     cr_assert(strtod(printed, NULL) < full.f_number, "the printed widest %s rounds down %.9g",
               printed, full.f_number);
     camera_free(&full);

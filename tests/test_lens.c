@@ -61,14 +61,14 @@ static void expect_minimal(const lens *l)
     cr_assert_eq(l->surface[0].radius_mm, 10.0);
     cr_assert_eq(l->surface[0].thickness_mm, 2.0);
     cr_assert_eq(l->surface[0].ior, 1.5);
-    cr_assert_eq(l->surface[0].aperture_mm, 8.0);
+    cr_assert_eq(l->surface[0].aperture_diameter_mm, 8.0);
     cr_assert_eq(l->surface[1].radius_mm, 0.0);
     cr_assert_eq(l->surface[1].ior, 1.0);
-    cr_assert_eq(l->surface[1].aperture_mm, 4.0);
+    cr_assert_eq(l->surface[1].aperture_diameter_mm, 4.0);
     cr_assert_eq(l->surface[2].radius_mm, -10.0);
     cr_assert_eq(l->surface[2].thickness_mm, 5.0);
     cr_assert_eq(l->surface[2].ior, 1.0);
-    cr_assert_eq(l->surface[2].aperture_mm, 8.0);
+    cr_assert_eq(l->surface[2].aperture_diameter_mm, 8.0);
 }
 
 /* A fresh directory under /tmp for file tests. */
@@ -195,7 +195,7 @@ Test(lens, radius_smaller_than_half_aperture)
     REFUSED(FRONT STOP "-5 1 1.5 10.5\n", 3, "radius -5 is too small for aperture diameter 10.5");
     /* The stop has no radius: any opening. */
     lens l = parsed("10 2 1.5 8\n0 1 0 400\n-10 5 1 8\n");
-    cr_assert_eq(l.surface[1].aperture_mm, 400.0);
+    cr_assert_eq(l.surface[1].aperture_diameter_mm, 400.0);
     lens_free(&l);
 }
 
@@ -330,15 +330,15 @@ Test(lens, exponents_and_signs)
     cr_assert_eq(l.surface[0].radius_mm, 10.0);
     cr_assert_eq(l.surface[0].thickness_mm, 2.0);
     cr_assert_eq(l.surface[0].ior, 1.5);
-    cr_assert_eq(l.surface[0].aperture_mm, 8.0);
+    cr_assert_eq(l.surface[0].aperture_diameter_mm, 8.0);
     cr_assert_eq(l.stop, 1);
     cr_assert_eq(l.surface[2].radius_mm, -10.0);
     cr_assert_eq(l.surface[2].thickness_mm, 5.0);
-    cr_assert_eq(l.surface[2].aperture_mm, 8.0);
+    cr_assert_eq(l.surface[2].aperture_diameter_mm, 8.0);
     lens_free(&l);
     l = parsed("10 2 1.5 2.5E-1\n0 1 0 .5\n-10 5. 1 8\n");
-    cr_assert_eq(l.surface[0].aperture_mm, 0.25);
-    cr_assert_eq(l.surface[1].aperture_mm, 0.5);
+    cr_assert_eq(l.surface[0].aperture_diameter_mm, 0.25);
+    cr_assert_eq(l.surface[1].aperture_diameter_mm, 0.5);
     cr_assert_eq(l.surface[2].thickness_mm, 5.0);
     lens_free(&l);
 }
@@ -741,7 +741,7 @@ Test(lens, shipped_rows_match_tables)
             cr_assert_eq(f->radius_mm, t->radius, "%s row %d", s->file, i);
             cr_assert_eq(f->thickness_mm, t->thickness, "%s row %d", s->file, i);
             cr_assert_eq(f->ior, t->ior == 0 ? 1.0 : t->ior, "%s row %d", s->file, i);
-            cr_assert_eq(f->aperture_mm, t->aperture, "%s row %d", s->file, i);
+            cr_assert_eq(f->aperture_diameter_mm, t->aperture, "%s row %d", s->file, i);
             cr_assert(i == 0 || f->line > l.surface[i - 1].line);
         }
         /* The header comment names the source before the first row. */
@@ -814,7 +814,7 @@ Test(lens, sag_matches_sphere_on_shipped_lenses)
         lens l = read_shipped(&SHIPPED[k]);
         for (int i = 0; i < l.count; i++) {
             const lens_surface *s = &l.surface[i];
-            const double rho = 0.5 * s->aperture_mm;
+            const double rho = 0.5 * s->aperture_diameter_mm;
             const double sag = lens_sag_mm(s, rho);
             if (i == l.stop) {
                 cr_assert_eq(sag, 0.0);

@@ -363,13 +363,13 @@ Test(pupil, every_passing_ray_lies_in_the_sampled_region, .timeout = 600)
                     o.width = 64;
                     o.height = 48;
                     o.focus_distance_units = fi ? (li == 3 ? 4.0 : 2.0) : 10.0;
-                    o.aperture_diameter_mm = openings[oi] * l.surface[l.stop].aperture_mm;
+                    o.aperture_diameter_mm = openings[oi] * l.surface[l.stop].aperture_diameter_mm;
                     o.pupil = (pupil_kind)kind;
                     o.weighting = WEIGHTING_PHYSICAL;
                     camera c;
                     cr_assert_eq(camera_setup(&c, &l, &o, &err), 0, "%s", err.text);
                     const lens_surface *rear = &c.lens.surface[c.lens.count - 1];
-                    const double reach = 0.75 * rear->aperture_mm, z = rear->vertex_z_mm;
+                    const double reach = 0.75 * rear->aperture_diameter_mm, z = rear->vertex_z_mm;
                     for (int i = 0; i < POINTS + 4; i++) {   /* and between the nodes */
                         const double along[4] = {0.13, 0.37, 0.61, 0.87};
                         const vec3 p = i < POINTS ? film_point(&c, i)

@@ -110,7 +110,7 @@ static char *bundled_scaled(const char *name, double scale, const char *extra_fr
         len += (size_t)snprintf(s + len, cap - len, "%.17g %.17g %.17g %.17g\n",
                                 f->radius_mm * scale, thickness * scale,
                                 f->radius_mm == 0.0 && f->ior == 1.0 ? 0.0 : f->ior,
-                                f->aperture_mm * scale);
+                                f->aperture_diameter_mm * scale);
     }
     if (extra_rear)
         snprintf(s + len, cap - len, "%s", extra_rear);
@@ -358,7 +358,7 @@ static double lens_size_mm(const lens *l)
 {
     double s = lens_total_length_mm(l);
     for (int i = 0; i < l->count; i++)
-        s = fmax(s, l->surface[i].aperture_mm);
+        s = fmax(s, l->surface[i].aperture_diameter_mm);
     return s;
 }
 

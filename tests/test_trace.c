@@ -16,7 +16,7 @@ static lens_surface sphere(double radius, double vertex_z)
     s.radius_mm = radius;
     s.curvature_per_mm = radius == 0.0 ? 0.0 : 1.0 / radius;
     s.vertex_z_mm = vertex_z;
-    s.aperture_mm = 1e300;
+    s.aperture_diameter_mm = 1e300;
     return s;
 }
 

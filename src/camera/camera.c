@@ -65,7 +65,7 @@ vec3 camera_world_from_camera_dir(const camera *c, vec3 d)
    the entrance pupil scales with the stop). */
 static int setup_aperture(lens *l, const camera_options *o, double efl_mm, l2p_error *err)
 {
-    const double full = l->surface[l->stop].aperture_mm;
+    const double full = l->surface[l->stop].aperture_diameter_mm;
     double diameter = full;
     if (!isnan(o->aperture_diameter_mm)) {
         diameter = o->aperture_diameter_mm;
@@ -103,8 +103,8 @@ static int check_film_position(const lens *l, bool from_option, double focus_mm,
     double size = lens_total_length_mm(l);
     for (int i = 0; i < l->count; i++) {
         const lens_surface *s = &l->surface[i];
-        size = fmax(size, s->aperture_mm);
-        const double lowest = s->vertex_z_mm + fmin(0.0, lens_sag_mm(s, 0.5 * s->aperture_mm));
+        size = fmax(size, s->aperture_diameter_mm);
+        const double lowest = s->vertex_z_mm + fmin(0.0, lens_sag_mm(s, 0.5 * s->aperture_diameter_mm));
         if (lowest < 0.0)
             return l2p_fail(err, L2P_BAD_INPUT, l->path, s->line,
                             "the film (%g mm behind the rear vertex) is inside the lens: the rim "

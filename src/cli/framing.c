@@ -69,7 +69,7 @@ static int solve_film(camera *cam, const lens *l, const cli *c, l2p_error *err)
     const double half_deg = 0.5 * c->angle_deg;
     double widest = 0.0;
     for (int i = 0; i < l->count; i++)
-        widest = fmax(widest, l->surface[i].aperture_mm);
+        widest = fmax(widest, l->surface[i].aperture_diameter_mm);
     /* Beyond a few times the widest element the lens passes nothing: the field is its
        image circle's there. */
     double x = 4.0 * widest;

@@ -12,7 +12,7 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
     lens l;
     if (lens_copy(&l, src))
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    l.stop_diameter_mm = l.surface[l.stop].aperture_mm;
+    l.stop_diameter_mm = l.surface[l.stop].aperture_diameter_mm;
     lens_set_film_distance(&l, 0.0);
     thick_lens t;
     pupil exit;

@@ -89,7 +89,7 @@ static void fit_view(scene *s)
     v->ymax = 0.5 * s->c->film.diagonal_mm;
     for (int i = 0; i < l->count; i++)
         grow(v, l->surface[i].vertex_z_mm + lens_sag_mm(&l->surface[i], lens_semi_aperture_mm(l, i)),
-             0.5 * l->surface[i].aperture_mm);
+             0.5 * l->surface[i].aperture_diameter_mm);
     const double marks[] = {s->t.p1_z_mm, s->t.p2_z_mm, s->t.f1_z_mm, s->t.f2_z_mm, s->ep_z, s->xp_z};
     for (int i = 0; i < 6; i++)
         if (isfinite(marks[i]))
@@ -187,7 +187,7 @@ static void draw_labels(FILE *out, const scene *s)
     draw_mark(out, v, "mark", "F2", s->t.f2_z_mm, 2.2 * tick);
     svg_text(out, "label", svg_x(v, s->ep_z), svg_y(v, -s->ep_r) + 14.0, "EP");
     svg_text(out, "label", svg_x(v, s->xp_z), svg_y(v, -s->xp_r) + 14.0, "XP");
-    const double a = lens_semi_aperture_mm(l, l->stop), big = 0.5 * l->surface[l->stop].aperture_mm;
+    const double a = lens_semi_aperture_mm(l, l->stop), big = 0.5 * l->surface[l->stop].aperture_diameter_mm;
     svg_text(out, "label", svg_x(v, l->surface[l->stop].vertex_z_mm),
              svg_y(v, fmax(a, big) + 0.1 * v->ymax) - 4.0, "stop");
     svg_text(out, "label", svg_x(v, 0.0), svg_y(v, 0.5 * s->c->film.diagonal_mm) - 4.0, "film");
@@ -210,7 +210,7 @@ static void draw(FILE *out, const scene *s)
     svg_begin(out, v);
     fprintf(out, "<line class=\"axis\" x1=\"%.12g\" y1=\"0\" x2=\"%.12g\" y2=\"0\"/>\n", v->zmin, v->zmax);
     draw_elements(out, l);
-    const double a = lens_semi_aperture_mm(l, l->stop), big = 0.5 * l->surface[l->stop].aperture_mm;
+    const double a = lens_semi_aperture_mm(l, l->stop), big = 0.5 * l->surface[l->stop].aperture_diameter_mm;
     draw_bars(out, "stop", l->surface[l->stop].vertex_z_mm, a, fmax(a, big) + 0.1 * v->ymax);
     draw_bars(out, "pupil", s->ep_z, s->ep_r, s->ep_r + 0.04 * v->ymax);
     draw_bars(out, "pupil", s->xp_z, s->xp_r, s->xp_r + 0.04 * v->ymax);

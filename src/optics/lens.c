@@ -247,7 +247,7 @@ static int append_surface(const where *w, lens *l, int *capacity, const row *r)
         .curvature_per_mm = radius == 0.0 ? 0.0 : 1.0 / radius,
         .thickness_mm = r->value[1],
         .ior = radius == 0.0 && r->value[2] == 0.0 ? 1.0 : r->value[2],
-        .aperture_mm = r->value[3],
+        .aperture_diameter_mm = r->value[3],
         .abbe = r->count == 5 ? r->value[4] : 0.0,
         .vertex_z_mm = 0.0,
         .line = w->line,
@@ -371,7 +371,7 @@ int lens_parse(const char *text, size_t length, const char *name, lens *out, l2p
         lens_free(&l);
         return st;
     }
-    l.stop_diameter_mm = l.surface[l.stop].aperture_mm;
+    l.stop_diameter_mm = l.surface[l.stop].aperture_diameter_mm;
     l.film_distance_mm = 0.0;
     lens_set_film_distance(&l, 0.0);
     *out = l;

@@ -18,7 +18,7 @@ typedef struct lens_surface {
     double curvature_per_mm; /* 1 / radius, 0 for the stop */
     double thickness_mm;     /* axial distance to the next surface toward the film */
     double ior;              /* index of the medium behind this surface; 1 where the file says 0 */
-    double aperture_mm;      /* clear aperture diameter (the stop: its largest opening) */
+    double aperture_diameter_mm;  /* clear aperture (the stop: its largest opening) */
     double abbe;             /* V_d of the medium behind; 0 for air or when the file gives none */
     double vertex_z_mm;      /* camera space; set by lens_set_film_distance */
     int line;                /* line of the file that gave this row */
@@ -40,7 +40,7 @@ typedef struct lens {
     lens_surface *surface;   /* surface[0] faces the scene, surface[count-1] the film */
     int count;
     int stop;                /* index of the aperture stop row */
-    double stop_diameter_mm; /* current opening, at most surface[stop].aperture_mm */
+    double stop_diameter_mm; /* current opening, at most surface[stop].aperture_diameter_mm */
     double film_distance_mm; /* rear vertex to film */
     lens_blades blades;      /* the stop's shape (set by lens_set_blades; round at first) */
 } lens;
@@ -72,7 +72,7 @@ static inline double lens_ior_behind(const lens *l, int i) { return l->surface[i
 /* Semi-aperture of surface i, the stop's current opening for the stop. */
 static inline double lens_semi_aperture_mm(const lens *l, int i)
 {
-    return i == l->stop ? 0.5 * l->stop_diameter_mm : 0.5 * l->surface[i].aperture_mm;
+    return i == l->stop ? 0.5 * l->stop_diameter_mm : 0.5 * l->surface[i].aperture_diameter_mm;
 }
 
 /* Gives the stop `count` straight blades (0: round), one corner at rotation_rad from the +x

@@ -52,7 +52,7 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err)
         out->radius_mm = 0.5 * l->stop_diameter_mm;
     } else if (kind == PUPIL_REAR) {
         const lens_surface *rear = &l->surface[l->count - 1];
-        out->radius_mm = 0.5 * rear->aperture_mm;
+        out->radius_mm = 0.5 * rear->aperture_diameter_mm;
         out->z_mm = rear->vertex_z_mm + lens_sag_mm(rear, out->radius_mm);
     } else {
         int st = pupil_stop_image(l, true, &out->z_mm, &out->radius_mm, err);

@@ -111,7 +111,7 @@ static void boundary(const pupil *pu, const lens *l, double r, double x0, double
 static double search_half_side_mm(const pupil *pu, const lens *l, double r)
 {
     const lens_surface *rear = &l->surface[l->count - 1];
-    const double a = 0.5 * rear->aperture_mm;
+    const double a = 0.5 * rear->aperture_diameter_mm;
     const double z_near = rear->vertex_z_mm + fmin(0.0, lens_sag_mm(rear, a));
     if (!(z_near > 1e-3 * a))
         return 10.0 * (r + a) + fabs(pu->z_mm);

@@ -23,7 +23,7 @@ static double system_size_mm(const lens *l, int first, int last)
 {
     double size = l->surface[first].vertex_z_mm - l->surface[last].vertex_z_mm;
     for (int i = first; i <= last; i++)
-        size = fmax(size, l->surface[i].aperture_mm);
+        size = fmax(size, l->surface[i].aperture_diameter_mm);
     return size;
 }
 

@@ -300,7 +300,7 @@ int povmesh_open(povmesh_emitter **out, const camera *c, const char *prefix, con
     e->anchor_camera_mm = v3(0, 0, c->lens.surface[0].vertex_z_mm);
     double widest = 0.0;
     for (int i = 0; i < c->lens.count; i++)
-        widest = fmax(widest, c->lens.surface[i].aperture_mm);
+        widest = fmax(widest, c->lens.surface[i].aperture_diameter_mm);
     e->triangle_size = 0.5 * widest / c->unit_mm;
     choose_number_format(e, 4.0 * e->triangle_size);
     choose_layout(e, chunk_faces);

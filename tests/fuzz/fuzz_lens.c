@@ -62,7 +62,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fail("a lens without a stop or a surface", "");
     for (int i = 0; i < l.count; i++)
         if (!isfinite(l.surface[i].radius_mm) || !isfinite(l.surface[i].thickness_mm) ||
-            !isfinite(l.surface[i].ior) || !(l.surface[i].aperture_mm > 0) ||
+            !isfinite(l.surface[i].ior) || !(l.surface[i].aperture_diameter_mm > 0) ||
             !isfinite(l.surface[i].curvature_per_mm))
             fail("a surface that is not finite", "");
     camera_options o;
