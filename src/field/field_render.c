@@ -13,6 +13,7 @@
 #include "image/image_io.h"
 #include "optics/pupil.h"
 #include "povray/povray.h"
+#include "raytable/povmesh.h"
 
 typedef struct sub {
     field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
@@ -261,25 +262,6 @@ static int develop_render(const render_plan *p, const sub *subs, const char *exr
     return st;
 }
 
-static void fill_header(const camera *c, samplemap_header *h)
-{
-    memset(h, 0, sizeof *h);
-    h->film_width = c->film.width, h->film_height = c->film.height;
-    h->spp = c->samples.spp;
-    h->crop_x0 = c->crop_x0, h->crop_y0 = c->crop_y0, h->crop_x1 = c->crop_x1, h->crop_y1 = c->crop_y1;
-    snprintf(h->lens, sizeof h->lens, "%s", c->lens.name ? c->lens.name : "");
-    snprintf(h->pupil, sizeof h->pupil, "%s", pupil_kind_name(c->pupil.kind));
-    snprintf(h->trace, sizeof h->trace, "%s", c->trace == TRACE_KIND_THICK ? "thick" : "full");
-    snprintf(h->weighting, sizeof h->weighting, "%s",
-             c->weighting == WEIGHTING_PHYSICAL ? "physical" : "normalized");
-    h->f_number = c->f_number;
-    h->aperture_diameter_mm = c->lens.stop_diameter_mm;
-    h->focus_distance_units = c->focus_distance_units;
-    h->film_distance_mm = c->lens.film_distance_mm;
-    h->film_diagonal_mm = c->film.diagonal_mm;
-    h->unit_mm = c->unit_mm;
-}
-
 /* ---------------------------------------------------------------- the whole */
 
 static int render_and_develop(const camera *c, const field_render_options *o, sub *subs,
@@ -312,7 +294,7 @@ static int render_and_develop(const camera *c, const field_render_options *o, su
         st = develop_render(&plans[r], subs, ch[r].output_exr, o->work_dir, w, h, sums, err);
     if (!st) {
         samplemap map = {.records = NULL};
-        fill_header(c, &map.header);
+        povmesh_camera_header(c, &map.header);
         st = develop_write_picture(&map, sums, o->output, err);
     }
     free(sums);

@@ -408,9 +408,8 @@ int povmesh_append(povmesh_emitter *e, const formatted_faces *f, l2p_error *err)
     return L2P_OK;
 }
 
-static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)
+void povmesh_camera_header(const camera *c, samplemap_header *h)
 {
-    const camera *c = e->cam;
     memset(h, 0, sizeof *h);
     h->film_width = c->film.width;
     h->film_height = c->film.height;
@@ -419,11 +418,6 @@ static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)
     h->crop_y0 = c->crop_y0;
     h->crop_x1 = c->crop_x1;
     h->crop_y1 = c->crop_y1;
-    h->packed_width = e->packed_width;
-    h->faces = e->faces;
-    const long long one = e->faces > 0 ? e->faces : 1;
-    h->chunk_faces = e->chunk_faces ? e->chunk_faces
-                                    : (one + e->packed_width - 1) / e->packed_width * e->packed_width;
     snprintf(h->lens, sizeof h->lens, "%s", c->lens.name ? c->lens.name : "");
     snprintf(h->pupil, sizeof h->pupil, "%s", pupil_kind_name(c->pupil.kind));
     snprintf(h->trace, sizeof h->trace, "%s", c->trace == TRACE_KIND_THICK ? "thick" : "full");
@@ -435,6 +429,16 @@ static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)
     h->film_distance_mm = c->lens.film_distance_mm;
     h->film_diagonal_mm = c->film.diagonal_mm;
     h->unit_mm = c->unit_mm;
+}
+
+static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)
+{
+    povmesh_camera_header(e->cam, h);
+    h->packed_width = e->packed_width;
+    h->faces = e->faces;
+    const long long one = e->faces > 0 ? e->faces : 1;
+    h->chunk_faces = e->chunk_faces ? e->chunk_faces
+                                    : (one + e->packed_width - 1) / e->packed_width * e->packed_width;
 }
 
 static int finish_all(povmesh_emitter *e, l2p_error *err)

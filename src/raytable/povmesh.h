@@ -81,4 +81,8 @@ char *povmesh_chunk_file(const char *prefix, bool chunked, int index, const char
 int povmesh_close(povmesh_emitter *e, bool commit, int *chunk_count, l2p_error *err);
 
 
+/* The sample map header's description of the camera (film, crop, lens, pupil, aperture,
+   focus, units); the table's layout fields are left 0. */
+void povmesh_camera_header(const camera *c, samplemap_header *h);
+
 #endif
