@@ -476,12 +476,12 @@ Test(render, missing_scene_or_lens_is_bad_input)
     char *errtext;
     int st = L2P(NULL, &errtext, "render", missing, DGAUSS, "--width", "16", "--height", "12",
                  "--quiet", "-o", out);
-    cr_expect_eq(st, 2, "missing scene: exit status %d", st);
+    cr_expect_eq(st, 2, "missing scene: exit status %d: %s", st, errtext);
     cr_expect_not_null(strstr(errtext, missing), "stderr does not name %s:\n%s", missing, errtext);
     free(errtext);
     st = L2P(NULL, &errtext, "render", scene, lens, "--width", "16", "--height", "12", "--quiet",
              "-o", out);
-    cr_expect_eq(st, 2, "missing lens: exit status %d", st);
+    cr_expect_eq(st, 2, "missing lens: exit status %d: %s", st, errtext);
     cr_expect_not_null(strstr(errtext, lens), "stderr does not name %s:\n%s", lens, errtext);
     free(errtext);
     char listing[2048];

@@ -456,8 +456,7 @@ int render_command(const cli *given, l2p_error *err)
         return st;
     }
     pthread_t loader;
-    if (start_thread(&loader, load_image_library, NULL) == 0)
-        pthread_detach(loader);   /* image_io_ready waits for it */
+    const bool loading = start_thread(&loader, load_image_library, NULL) == 0;
     workspace w;
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
@@ -469,5 +468,10 @@ int render_command(const cli *given, l2p_error *err)
     outfile_discard(&csv);   /* nothing when committed */
     render_frames_free(&rf);
     povargs_free(args);
+    /* Joined, not detached: a render that fails early (a missing lens) must not exit while the
+       loader is inside the libraries' start-up, nor before its thread-local data is freed
+       (log4cplus, which OpenImageIO's DICOM reader loads, keeps some a thread). */
+    if (loading)
+        pthread_join(loader, NULL);
     return st;
 }
