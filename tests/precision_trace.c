@@ -17,13 +17,13 @@ static long double ld_dot(ld_vec a, ld_vec b) { return a.x * b.x + a.y * b.y + a
 trace_status precision_trace_range(const lens *l, int first, int last, bool toward_scene,
                                    ld_ray *r, int *blocked_at)
 {
-    return ld_through(l, first, last, toward_scene, r, blocked_at);
+    return ld_through(l, first, last, toward_scene, 0.0, r, blocked_at);
 }
 
 static int trace_array(const lens *l, bool toward_scene, long double o[3], long double d[3])
 {
     ld_ray r = {{o[0], o[1], o[2]}, {d[0], d[1], d[2]}};
-    const trace_status st = ld_through(l, 0, l->count - 1, toward_scene, &r, NULL);
+    const trace_status st = ld_through(l, 0, l->count - 1, toward_scene, 0.0, &r, NULL);
     o[0] = r.o.x;
     o[1] = r.o.y;
     o[2] = r.o.z;

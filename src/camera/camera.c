@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "optics/focus.h"
+#include "optics/spectrum.h"
 #include "optics/trace_batch.h"
 
 void camera_options_default(camera_options *o)
@@ -15,6 +16,7 @@ void camera_options_default(camera_options *o)
     o->film_diagonal_mm = 35.0;
     o->film_distance_mm = o->focus_distance_units = NAN;
     o->aperture_diameter_mm = o->f_number = NAN;
+    o->wavelength_nm = NAN;
     o->pupil = PUPIL_STOP_IMAGE;
     o->trace = TRACE_KIND_FULL;
     o->location = v3(0, 0, 0);
@@ -219,6 +221,42 @@ static int setup_film(camera *c, const camera_options *o, l2p_error *err)
     return L2P_OK;
 }
 
+static int setup_dispersion(camera *c, const camera_options *o, l2p_error *err)
+{
+    if (!isnan(o->wavelength_nm)) {
+        if (o->dispersion == DISPERSION_ON)
+            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--wavelength traces one wavelength, "
+                            "--dispersion on many: give one");
+        lens_at_wavelength(&c->lens, o->wavelength_nm);
+    }
+    const bool glass = lens_has_abbe(&c->lens);
+    c->dispersion = o->dispersion == DISPERSION_ON ||
+                    (o->dispersion == DISPERSION_AUTO && glass && o->trace == TRACE_KIND_FULL);
+    if (c->dispersion && !glass)
+        return l2p_fail(err, L2P_BAD_INPUT, c->lens.path, 0, "--dispersion on needs the Abbe "
+                        "numbers of the glasses (a fifth column): this lens gives none");
+    if (c->dispersion && o->trace == TRACE_KIND_THICK)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--dispersion on needs --trace full: the "
+                        "thick lens is one fit, at the d line");
+    return L2P_OK;
+}
+
+/* With dispersion the pupil fitted at the d line also covers the two ends of the spectrum;
+   between them the passing regions move little and smoothly (pupil_cover). */
+static int cover_spectrum(camera *c, l2p_error *err)
+{
+    const double ends[2] = {SPECTRUM_MIN_NM, SPECTRUM_MAX_NM};
+    for (int i = 0; i < 2; i++) {
+        lens at;
+        if (lens_copy(&at, &c->lens))
+            return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+        lens_at_wavelength(&at, ends[i]);
+        pupil_cover(&c->pupil, &at);
+        lens_free(&at);
+    }
+    return L2P_OK;
+}
+
 int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
 {
     memset(c, 0, sizeof *c);
@@ -228,6 +266,8 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
     int st = setup_film(c, o, err);
     if (!st)
         st = setup_placement(c, o, err);
+    if (!st)
+        st = setup_dispersion(c, o, err);
     /* The cardinal points are probed, and the focus found, by rays at a fixed fraction of the
        smallest opening, the stop's included: the opening is chosen with the full stop's focal
        length, and the points that the camera keeps are found again at the chosen opening and
@@ -244,8 +284,11 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
         st = pupil_make(&c->lens, o->pupil, &c->pupil, err);
     /* The stop pupil stays the seed's diagnostic, and thick tracing samples the stop's image,
        as the seed's third variant does: a thick lens blocks nothing. */
-    if (!st && o->pupil != PUPIL_STOP && o->trace == TRACE_KIND_FULL)
+    if (!st && o->pupil != PUPIL_STOP && o->trace == TRACE_KIND_FULL) {
         pupil_fit(&c->pupil, &c->lens, 0.5 * c->film.diagonal_mm);
+        if (c->dispersion)
+            st = cover_spectrum(c, err);
+    }
     if (!st) {
         double z, r;
         st = pupil_stop_image(&c->lens, false, &z, &r, err);
@@ -319,7 +362,7 @@ void camera_trace_batch(const camera *c, sample_batch *s)
         }
     } else {
         batch_from_rays(&b, s->film_point, direction, n);
-        trace_batch_toward_scene(&c->lens, &b, n);
+        trace_batch_toward_scene_at(&c->lens, &b, n, c->dispersion ? s->wavelength_nm : NULL);
         rays_from_batch(s->out, &b, n);
     }
     /* & rather than &&: whether a ray passed is unpredictable, a branch on it costly. */
@@ -335,6 +378,7 @@ bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out
     s.film_point[0] = film_point;
     s.u[0] = u;
     s.v[0] = v;
+    s.wavelength_nm[0] = WAVELENGTH_D_NM;
     camera_trace_batch(c, &s);
     *out = s.out[0];
     *weight = s.weight[0];

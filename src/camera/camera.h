@@ -14,6 +14,8 @@
 
 typedef enum trace_kind { TRACE_KIND_FULL, TRACE_KIND_THICK } trace_kind;
 typedef enum weighting { WEIGHTING_NORMALIZED, WEIGHTING_PHYSICAL } weighting;
+/* --dispersion: auto is on when the lens gives Abbe numbers and the trace is full. */
+typedef enum dispersion_mode { DISPERSION_AUTO, DISPERSION_ON, DISPERSION_OFF } dispersion_mode;
 
 /* The camera options of the command line. NAN (or 0 for the integers) means "not given". */
 typedef struct camera_options {
@@ -29,6 +31,8 @@ typedef struct camera_options {
     bool mirror;               /* right points left: the picture mirrored (a scene's camera) */
     double unit_mm;
     weighting weighting;
+    dispersion_mode dispersion;
+    double wavelength_nm;      /* NAN: the file's n_d; else every index at this wavelength */
     uint64_t seed;
     int crop_x0, crop_y0, crop_x1, crop_y1;          /* x1 = 0: the whole film */
 } camera_options;
@@ -44,6 +48,7 @@ typedef struct camera {
     thick_lens thick;          /* thick lens of the whole lens (for --trace thick and info) */
     trace_kind trace;
     weighting weighting;
+    bool dispersion;           /* each sample traced at its own wavelength (spectrum.h) */
     double weight_scale;       /* multiplies A cos^4 / Z^2 (1 when physical) */
     double focus_distance_units;  /* film plane to in-focus plane; INFINITY at infinity */
     double f_number;           /* rear focal length / entrance pupil diameter */
@@ -59,18 +64,21 @@ typedef struct camera {
 int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err);
 void camera_free(camera *c);
 
-/* Traces the film ray from film point p toward pupil sample (u, v) through the lens. On
+/* Traces the film ray from film point p toward pupil sample (u, v) through the lens, at the
+   d line when the camera has dispersion. On
    success gives the outgoing ray in camera space (origin on the front of the lens) and its
    weight, and returns true; false when the lens blocks it. */
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight);
 
 /* Film samples traced together, interleaved for speed: in, each one's film point and pupil
-   sample; out, its ray, its weight and whether the lens passed it. */
+   sample, and its wavelength when the camera has dispersion; out, its ray, its weight and
+   whether the lens passed it. */
 enum { CAMERA_BATCH = TRACE_BATCH_MAX };   /* one call of the batch tracer */
 typedef struct sample_batch {
     int n;                                  /* <= CAMERA_BATCH */
     vec3 film_point[CAMERA_BATCH];
     double u[CAMERA_BATCH], v[CAMERA_BATCH];
+    double wavelength_nm[CAMERA_BATCH];     /* read only with dispersion */
     ray out[CAMERA_BATCH];
     double weight[CAMERA_BATCH];
     bool passed[CAMERA_BATCH];

@@ -1,5 +1,7 @@
 #include "camera/film.h"
 
+#include "optics/spectrum.h"
+
 void film_init(film *f, int width, int height, double diagonal_mm)
 {
     const double a = (double)height / (double)width;
@@ -86,10 +88,25 @@ film_sample sample_pattern_sample(const sample_pattern *p, sample_pixel pixel, i
     s.offset_y = (ky + unit_double(mix64(h1))) / p->gy;
     s.pupil_u = (pkx + unit_double(h2)) / p->gx;
     s.pupil_v = (pky + unit_double(mix64(h2))) / p->gy;
+    s.wavelength_nm = 0.0;
     return s;
 }
 
 film_sample sample_pattern_get(const sample_pattern *p, int px, int py, int k)
 {
     return sample_pattern_sample(p, sample_pattern_pixel(p, px, py), k);
+}
+
+/* Hashes 4k + 1 and 4k + 2 give the pixel and pupil jitters; 4k + 3 the wavelength's. */
+wavelength_sample sample_pattern_wavelength(const sample_pattern *p, sample_pixel pixel, int k)
+{
+    const uint32_t band = permute((uint32_t)k, (uint32_t)p->spp, p->permute_mask,
+                                  (uint32_t)(pixel.hash >> 32));
+    const double u = (band + unit_double(mix64(pixel.hash + 4 * (uint64_t)k + 3))) / p->spp;
+    return (wavelength_sample){(int)band, spectrum_wavelength_nm(u)};
+}
+
+sample_pixel sample_pattern_shared(const sample_pattern *p)
+{
+    return (sample_pixel){mix64(p->seed ^ 0x5eedf1e1d0000000ULL)};
 }

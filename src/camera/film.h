@@ -31,6 +31,7 @@ static inline vec3 film_camera_from_raster(const film *f, double rx, double ry)
 typedef struct film_sample {
     double offset_x, offset_y; /* in the pixel, [0, 1) */
     double pupil_u, pupil_v;   /* on the unit square, [0, 1) */
+    double wavelength_nm;      /* with dispersion (sample_pattern_wavelength); else 0 */
 } film_sample;
 
 typedef struct sample_pattern {
@@ -57,5 +58,19 @@ void sample_pattern_init(sample_pattern *p, int spp, uint64_t seed);
 sample_pixel sample_pattern_pixel(const sample_pattern *p, int px, int py);
 film_sample sample_pattern_sample(const sample_pattern *p, sample_pixel pixel, int k);
 film_sample sample_pattern_get(const sample_pattern *p, int px, int py, int k);
+
+/* With --dispersion, a sample's wavelength: the spp samples of a pixel take one band each of
+   spp equal shares of the wavelength density (spectrum.h), through a second per-pixel
+   permutation, so that the bands are paired with neither the pixel nor the pupil strata; the
+   wavelength is jittered within its band. */
+typedef struct wavelength_sample {
+    int band;                  /* 0 .. spp - 1 */
+    double nm;
+} wavelength_sample;
+
+wavelength_sample sample_pattern_wavelength(const sample_pattern *p, sample_pixel pixel, int k);
+
+/* What the sub-images of --sampling field share instead of a pixel: a hash of the seed alone. */
+sample_pixel sample_pattern_shared(const sample_pattern *p);
 
 #endif

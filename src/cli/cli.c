@@ -44,6 +44,9 @@ typedef struct cli_option {
 static const cli_option OPTIONS[] = {
     {"--json", NULL, CMD_INFO, true, false,
      "  --json                        JSON instead of text [text]\n"},
+    {"--wavelength", NULL, CMD_INFO, false, false,
+     "  --wavelength NM               the lens at one wavelength, 300 to 1100 nm\n"
+     "                                [the file's n_d, 587.56 nm]\n"},
     {"--output", "-o", CMD_TRACE, false, false,
      "  -o, --output PREFIX           (required)\n"},
     {"--output", "-o", CMD_DEVELOP, false, false,
@@ -111,6 +114,13 @@ static const cli_option OPTIONS[] = {
      "  --trace full|thick            [full]\n"},
     {"--weighting", NULL, CMD_SAMPLES, false, true,
      "  --weighting normalized|physical   [normalized]\n"},
+    {"--dispersion", NULL, CMD_SAMPLES, false, true,
+     "  --dispersion on|off           each sample at its own wavelength, its colour\n"
+     "                                weighted by the CIE 1931 observer [on when the\n"
+     "                                lens gives Abbe numbers and --trace is full]\n"},
+    {"--wavelength", NULL, CMD_CAMERA & ~CMD_INFO, false, true,
+     "  --wavelength NM               the lens at one wavelength, 300 to 1100 nm\n"
+     "                                [the file's n_d, 587.56 nm]\n"},
     {"--location", NULL, CMD_CAMERA, false, true,
      "  --location X,Y,Z [0,0,0]  --look-at X,Y,Z [0,0,1]  --sky X,Y,Z [0,1,0]\n"
      "                                [with a scene: the scene's camera]\n"},
@@ -198,6 +208,15 @@ static int lens_option(cli *c, const char *opt, const char *v, l2p_error *err)
         o->weighting = strcmp(v, "physical") ? WEIGHTING_NORMALIZED : WEIGHTING_PHYSICAL;
         return L2P_OK;
     }
+    if (!strcmp(opt, "--dispersion")) {
+        if (strcmp(v, "on") && strcmp(v, "off"))
+            return value_bad(err, opt, "on or off", v);
+        o->dispersion = strcmp(v, "on") ? DISPERSION_OFF : DISPERSION_ON;
+        return L2P_OK;
+    }
+    /* The Cauchy fit through n_d, n_F and n_C holds for visible light and a little beyond. */
+    if (!strcmp(opt, "--wavelength"))
+        return value_double_in(opt, v, 300.0, 1100.0, &o->wavelength_nm, err);
     if (!strcmp(opt, "--seed")) {
         char *end;
         errno = 0;

@@ -80,7 +80,8 @@ static void print_fields(FILE *out, const field *f, int n, bool json)
     }
 }
 
-void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, bool json)
+void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,
+                double wavelength_nm, bool json)
 {
     field f[32] = {
         {"efl_mm", "effective focal length", "mm", li->efl_mm},
@@ -122,6 +123,10 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, 
             f[n++] = (field){"blades_f_number", "f-number of the blades' light", "",
                              c->f_number / sqrt(blades * sin(2 * M_PI / blades) / (2 * M_PI))};
     }
+    if (!isnan(wavelength_nm)) {   /* first */
+        memmove(f + 1, f, sizeof *f * (size_t)n++);
+        f[0] = (field){"wavelength_nm", "wavelength", "nm", wavelength_nm};
+    }
     if (json) {
         fputs("{\n  \"lens\": \"", out);
         for (const char *p = l->name; *p; p++)
@@ -133,7 +138,8 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, 
     }
     else
         fprintf(out, "%s (%d surfaces, stop on line %d%s)\n", l->path, l->count,
-                l->surface[l->stop].line, lens_has_abbe(l) ? ", Abbe numbers given" : "");
+                l->surface[l->stop].line, lens_has_abbe(l) ? ", Abbe numbers given"
+                                          : isnan(wavelength_nm) ? "" : ", one wavelength");
     print_fields(out, f, n, json);
     if (json)
         fprintf(out, "}\n");
@@ -145,6 +151,8 @@ int info_command(const cli *c, l2p_error *err)
     lens l;
     if (st || (st = lens_read_named(c->positional[0], &l, err)))
         return st;
+    if (!isnan(c->cam.wavelength_nm))
+        lens_at_wavelength(&l, c->cam.wavelength_nm);
     lens_info li;
     camera cam;
     bool with_camera = c->film_given;
@@ -161,7 +169,7 @@ int info_command(const cli *c, l2p_error *err)
     if (!st && with_camera)
         cli_warn(c, &cam);
     if (!st)
-        info_print(stdout, &l, &li, with_camera ? &cam : NULL, c->json);
+        info_print(stdout, &l, &li, with_camera ? &cam : NULL, c->cam.wavelength_nm, c->json);
     if (with_camera && !st)
         camera_free(&cam);
     lens_free(&l);

@@ -21,7 +21,9 @@ int lens_info_of(const lens *l, lens_info *out, l2p_error *err);
    when even the centre's ray is blocked. */
 double info_half_field_deg(const camera *c, vec3 p);
 
-/* Prints them, and the camera's focus and field of view when c is not NULL. */
-void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c, bool json);
+/* Prints them, and the camera's focus and field of view when c is not NULL; the wavelength
+   first when it is not NAN (the lens was taken to it). */
+void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,
+                double wavelength_nm, bool json);
 
 #endif

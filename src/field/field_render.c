@@ -12,12 +12,14 @@
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "optics/pupil.h"
+#include "optics/spectrum.h"
 #include "povray/povray.h"
 #include "raytable/povmesh.h"
 
 typedef struct sub {
     field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
     float *weights;            /* one a crop pixel, while building; then in its file */
+    double colour[3];          /* its wavelength band's colour weights; 1 without dispersion */
     field_stats stats;
     int render, dx, dy;        /* where it is rendered */
 } sub;
@@ -78,6 +80,21 @@ static int load_weights(const char *dir, int k, float *weights, size_t n, l2p_er
     return st;
 }
 
+/* Sub-image k's shared sample; with dispersion also its wavelength, the bands dealt out to
+   the sub-images as pixel sampling deals them to a pixel's samples, and the band's colour. */
+static film_sample shared_sample(const camera *c, int k, double colour[3])
+{
+    film_sample s = sobol_shared_sample(c->samples.seed, (uint32_t)k);
+    colour[0] = colour[1] = colour[2] = 1.0;
+    if (c->dispersion) {
+        const wavelength_sample w = sample_pattern_wavelength(&c->samples,
+                                                              sample_pattern_shared(&c->samples), k);
+        s.wavelength_nm = w.nm;
+        spectrum_band_weights(w.band, c->samples.spp, colour);
+    }
+    return s;
+}
+
 static void *build_worker(void *arg)
 {
     job *j = arg;
@@ -86,8 +103,9 @@ static void *build_worker(void *arg)
         sub *s = &j->subs[k];
         l2p_error e;
         s->weights = malloc(pixels * sizeof *s->weights);
-        int st = s->weights ? field_build_subimage(j->c, sobol_shared_sample(j->c->samples.seed, (uint32_t)k),
-                                                   j->tol, FIELD_BASE_CELL, &s->mesh, s->weights, &s->stats, &e)
+        const film_sample shared = shared_sample(j->c, k, s->colour);
+        int st = s->weights ? field_build_subimage(j->c, shared, j->tol, FIELD_BASE_CELL, &s->mesh,
+                                                   s->weights, &s->stats, &e)
                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
         if (!st && !(s->stats.worst_pixels <= j->tol->pixels))
             st = l2p_fail(&e, L2P_BAD_INPUT, NULL, 0,
@@ -255,7 +273,7 @@ static int develop_render(const render_plan *p, const sub *subs, const char *exr
                     continue;   /* blocked: no face, black */
                 const float *px = rgba + 4 * ((size_t)(s->dy + y + 1) * iw + s->dx + x);
                 for (int ch = 0; ch < 3; ch++)
-                    sums[3 * ((size_t)y * w + x) + ch] += (double)wt * px[ch];
+                    sums[3 * ((size_t)y * w + x) + ch] += (double)wt * s->colour[ch] * px[ch];
             }
     }
     free(rgba), free(weights);

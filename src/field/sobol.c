@@ -83,5 +83,5 @@ film_sample sobol_shared_sample(uint64_t seed, uint32_t k)
         uint32_t s = hash32(seed * 4 + (uint64_t)dim + 0x9e3779b97f4a7c15ULL);
         t[dim] = unit(sobol_owen_scramble(sobol_bits(k, dim), s));
     }
-    return (film_sample){t[0], t[1], t[2], t[3]};
+    return (film_sample){t[0], t[1], t[2], t[3], 0.0};
 }

@@ -61,6 +61,7 @@ static void trace_all(builder *b, film_sample s)
             batch->film_point[k] = film_camera_from_raster(&c->film, rx, ry);
             batch->u[k] = s.pupil_u;
             batch->v[k] = s.pupil_v;
+            batch->wavelength_nm[k] = s.wavelength_nm;
         }
         camera_trace_batch(c, batch);
         for (int k = 0; k < batch->n; k++) {

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "image/image_io.h"
+#include "optics/spectrum.h"
 
 static long long crop_width(const samplemap_header *h) { return h->crop_x1 - h->crop_x0; }
 static long long crop_height(const samplemap_header *h) { return h->crop_y1 - h->crop_y0; }
@@ -38,16 +39,31 @@ static long long crop_index(const samplemap_header *h, uint32_t film_pixel)
     return y * crop_width(h) + x;
 }
 
-static int add_sample(const samplemap *map, long long face, const float *rgba, double *sums,
-                      l2p_error *err)
+/* The colour weights of every wavelength band (spectrum.h), or NULL without dispersion. */
+static double (*band_weights(const samplemap_header *h))[3]
+{
+    if (h->wavelength_bands <= 0)
+        return NULL;
+    double (*w)[3] = malloc(sizeof *w * (size_t)h->wavelength_bands);
+    for (int b = 0; w && b < h->wavelength_bands; b++)
+        spectrum_band_weights(b, h->wavelength_bands, w[b]);
+    return w;
+}
+
+/* Adds face's colour into its film pixel: its weight times each channel, and with dispersion
+   times its band's weight of that channel. */
+static int add_sample(const samplemap *map, const double (*colour)[3], long long face,
+                      const float *rgba, double *sums, l2p_error *err)
 {
     const samplemap_record *r = &map->records[face];
     const long long i = crop_index(&map->header, r->film_pixel);
     if (i < 0)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "face %lld: film pixel %lu outside the crop",
                         face, (unsigned long)r->film_pixel);
+    static const double white[3] = {1.0, 1.0, 1.0};
+    const double *w = colour ? colour[map->band[face]] : white;
     for (int c = 0; c < 3; c++)
-        sums[3 * i + c] += (double)r->weight * (double)rgba[c];
+        sums[3 * i + c] += (double)r->weight * w[c] * (double)rgba[c];
     return L2P_OK;
 }
 
@@ -58,19 +74,21 @@ int develop_accumulate(const samplemap *map, long long chunk, const float *rgba,
     int st = check_chunk_image(h, chunk, width, height, err);
     if (st)
         return st;
+    double (*colour)[3] = band_weights(h);
+    if (h->wavelength_bands > 0 && !colour)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     /* Image row y >= 1 shows face row y - 1 (POV-Ray 3.7.0.10, FS#254); row 0 is a duplicate. */
     const long long first = chunk * h->chunk_faces;
-    for (int y = 1; y < height; y++)
-        for (int x = 0; x < width; x++) {
+    for (int y = 1; y < height && !st; y++)
+        for (int x = 0; x < width && !st; x++) {
             const long long face = first + (long long)(y - 1) * width + x;
             if (face >= h->faces)   /* past the table: the unused end of the last row */
-                return L2P_OK;
-            st = add_sample(map, face, rgba + 4 * ((size_t)y * (size_t)width + (size_t)x),
-                            sums, err);
-            if (st)
-                return st;
+                break;
+            st = add_sample(map, (const double (*)[3])colour, face,
+                            rgba + 4 * ((size_t)y * (size_t)width + (size_t)x), sums, err);
         }
-    return L2P_OK;
+    free(colour);
+    return st;
 }
 
 void develop_finish(const samplemap *map, const double *sums, float *rgb)

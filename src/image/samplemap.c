@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,7 +13,12 @@
    written as their IEEE-754 bit patterns. */
 _Static_assert(sizeof(float) == 4, "float must be IEEE-754 binary32");
 
-enum { RECORD_BYTES = 16, BATCH_RECORDS = 1024 };
+enum { RECORD_BYTES = 16, BAND_BYTES = 4, BATCH_RECORDS = 1024 };
+
+static long long record_bytes(const samplemap_header *h)
+{
+    return RECORD_BYTES + (h->wavelength_bands > 0 ? BAND_BYTES : 0);
+}
 
 static const char MAGIC[] = "lens2pov-samplemap 1";
 
@@ -94,16 +100,22 @@ int samplemap_begin(FILE *fp)
     return fwrite(blank, 1, sizeof blank, fp) == sizeof blank ? L2P_OK : L2P_FAILED;
 }
 
-int samplemap_append(FILE *fp, const samplemap_record *records, size_t count)
+int samplemap_append(FILE *fp, const samplemap_record *records, const uint32_t *band,
+                     size_t count)
 {
-    unsigned char buf[BATCH_RECORDS * RECORD_BYTES];
+    const size_t size = RECORD_BYTES + (band ? BAND_BYTES : 0);
+    unsigned char buf[BATCH_RECORDS * (RECORD_BYTES + BAND_BYTES)];
     while (count > 0) {
         const size_t n = count < BATCH_RECORDS ? count : BATCH_RECORDS;
-        for (size_t i = 0; i < n; i++)
-            pack_record(buf + i * RECORD_BYTES, &records[i]);
-        if (fwrite(buf, RECORD_BYTES, n, fp) != n)
+        for (size_t i = 0; i < n; i++) {
+            pack_record(buf + i * size, &records[i]);
+            if (band)
+                put_u32(buf + i * size + RECORD_BYTES, band[i]);
+        }
+        if (fwrite(buf, size, n, fp) != n)
             return L2P_FAILED;
         records += n;
+        band = band ? band + n : NULL;
         count -= n;
     }
     return L2P_OK;
@@ -137,7 +149,14 @@ static int format_header(const samplemap_header *h, char *buf, size_t size)
         h->crop_y1, h->packed_width, h->faces, h->chunk_faces, lens, pupil, trace, weighting,
         h->f_number, h->aperture_diameter_mm, h->focus_distance_units, h->film_distance_mm,
         h->film_diagonal_mm, h->unit_mm);
-    return n >= 0 && (size_t)n < size ? n : -1;
+    if (n < 0 || (size_t)n >= size)
+        return -1;
+    if (h->wavelength_bands <= 0)
+        return n;
+    /* "wavelength_bands N" goes before "end". */
+    const int m = snprintf(buf + n - 4, size - (size_t)n + 4, "wavelength_bands %d\nend\n",
+                           h->wavelength_bands);
+    return m >= 0 && (size_t)(n - 4 + m) < size ? n - 4 + m : -1;
 }
 
 int samplemap_finish(FILE *fp, const samplemap_header *h)
@@ -148,7 +167,7 @@ int samplemap_finish(FILE *fp, const samplemap_header *h)
         return L2P_FAILED;
     /* The records written so far must be exactly the faces the header announces. */
     const off_t end = ftello(fp);
-    if (end != (off_t)(SAMPLEMAP_HEADER_BYTES + RECORD_BYTES * h->faces))
+    if (end != (off_t)(SAMPLEMAP_HEADER_BYTES + record_bytes(h) * h->faces))
         return L2P_FAILED;
     memset(text + n, ' ', SAMPLEMAP_HEADER_BYTES - (size_t)n);
     if (fseeko(fp, 0, SEEK_SET) != 0 || fwrite(text, 1, SAMPLEMAP_HEADER_BYTES, fp) !=
@@ -165,10 +184,11 @@ typedef struct field {
     const char *key;
     field_type type;
     size_t offset, size;
+    bool optional;
 } field;
 
 #define FIELD(name, type) {#name, type, offsetof(samplemap_header, name), \
-                           sizeof(((samplemap_header *)0)->name)}
+                           sizeof(((samplemap_header *)0)->name), false}
 static const field FIELDS[] = {
     FIELD(film_width, FIELD_INT),       FIELD(film_height, FIELD_INT),
     FIELD(spp, FIELD_INT),              FIELD(crop_x0, FIELD_INT),
@@ -180,6 +200,7 @@ static const field FIELDS[] = {
     FIELD(f_number, FIELD_DOUBLE),      FIELD(aperture_diameter_mm, FIELD_DOUBLE),
     FIELD(focus_distance_units, FIELD_DOUBLE), FIELD(film_distance_mm, FIELD_DOUBLE),
     FIELD(film_diagonal_mm, FIELD_DOUBLE),     FIELD(unit_mm, FIELD_DOUBLE),
+    {"wavelength_bands", FIELD_INT, offsetof(samplemap_header, wavelength_bands), sizeof(int), true},
 };
 #undef FIELD
 enum { FIELD_COUNT = sizeof FIELDS / sizeof FIELDS[0] };
@@ -248,7 +269,7 @@ static int check_padding(const char *p, const char *end, const char *path, l2p_e
 static int check_all_seen(const int *seen, const char *path, l2p_error *err)
 {
     for (int i = 0; i < FIELD_COUNT; i++)
-        if (!seen[i])
+        if (!seen[i] && !FIELDS[i].optional)
             return l2p_fail(err, L2P_BAD_INPUT, path, 0, "header has no '%s'", FIELDS[i].key);
     return L2P_OK;
 }
@@ -308,13 +329,14 @@ static int check_layout(const samplemap_header *h, long long file_bytes, const c
         return l2p_fail(err, L2P_BAD_INPUT, path, 0,
                         "chunk_faces %lld is not a positive multiple of packed_width %d",
                         h->chunk_faces, h->packed_width);
-    const long long record_bytes = file_bytes - SAMPLEMAP_HEADER_BYTES;
-    if (h->faces < 0 || h->faces > record_bytes / RECORD_BYTES ||
-        record_bytes != RECORD_BYTES * h->faces)
+    if (h->wavelength_bands < 0 || (h->wavelength_bands > 0 && h->wavelength_bands != h->spp))
+        return l2p_fail(err, L2P_BAD_INPUT, path, 0, "wavelength_bands %d is neither 0 nor spp %d",
+                        h->wavelength_bands, h->spp);
+    const long long bytes = file_bytes - SAMPLEMAP_HEADER_BYTES, size = record_bytes(h);
+    if (h->faces < 0 || h->faces > bytes / size || bytes != size * h->faces)
         return l2p_fail(err, L2P_BAD_INPUT, path, 0,
                         "header says %lld faces but the file holds %lld bytes of records "
-                        "(%d bytes a face): truncated or corrupt",
-                        h->faces, record_bytes, RECORD_BYTES);
+                        "(%lld bytes a face): truncated or corrupt", h->faces, bytes, size);
     return L2P_OK;
 }
 
@@ -338,22 +360,35 @@ static int check_record(const samplemap_header *h, const samplemap_record *r, lo
     return L2P_OK;
 }
 
+static int check_band(const samplemap_header *h, uint32_t band, long long face, const char *path,
+                      l2p_error *err)
+{
+    if (band >= (uint32_t)h->wavelength_bands)
+        return l2p_fail(err, L2P_BAD_INPUT, path, 0, "face %lld: wavelength band %lu is not "
+                        "below %d", face, (unsigned long)band, h->wavelength_bands);
+    return L2P_OK;
+}
+
 /* ---- reading ---- */
 
 static int read_records(FILE *fp, samplemap *m, const char *path, l2p_error *err)
 {
-    unsigned char buf[BATCH_RECORDS * RECORD_BYTES];
+    unsigned char buf[BATCH_RECORDS * (RECORD_BYTES + BAND_BYTES)];
     const long long faces = m->header.faces;
+    const size_t size = (size_t)record_bytes(&m->header);
     for (long long done = 0; done < faces;) {
         const size_t n = (size_t)(faces - done < BATCH_RECORDS ? faces - done : BATCH_RECORDS);
-        if (fread(buf, RECORD_BYTES, n, fp) != n)
+        if (fread(buf, size, n, fp) != n)
             return l2p_fail(err, ferror(fp) ? L2P_FAILED : L2P_BAD_INPUT, path, 0,
                             "cannot read the records: %s",
                             ferror(fp) ? strerror(errno) : "file ends early");
         for (size_t i = 0; i < n; i++) {
-            unpack_record(buf + i * RECORD_BYTES, &m->records[done + (long long)i]);
-            int st = check_record(&m->header, &m->records[done + (long long)i],
-                                  done + (long long)i, path, err);
+            const long long face = done + (long long)i;
+            unpack_record(buf + i * size, &m->records[face]);
+            int st = check_record(&m->header, &m->records[face], face, path, err);
+            if (!st && m->band)
+                st = check_band(&m->header, m->band[face] = get_u32(buf + i * size + RECORD_BYTES),
+                                face, path, err);
             if (st)
                 return st;
         }
@@ -389,9 +424,13 @@ int samplemap_read(const char *path, samplemap *out, l2p_error *err)
     int st = read_header(fp, &out->header, path, err);
     if (!st) {
         /* One extra record so that an empty table still gets a pointer of its own. */
-        out->records = malloc(sizeof *out->records * (size_t)(out->header.faces + 1));
-        st = out->records ? read_records(fp, out, path, err)
-                          : l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
+        const size_t n = (size_t)(out->header.faces + 1);
+        out->records = malloc(sizeof *out->records * n);
+        if (out->header.wavelength_bands > 0)
+            out->band = malloc(sizeof *out->band * n);
+        st = out->records && (out->band || out->header.wavelength_bands == 0)
+                 ? read_records(fp, out, path, err)
+                 : l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
     }
     fclose(fp);
     if (st)
@@ -402,5 +441,7 @@ int samplemap_read(const char *path, samplemap *out, l2p_error *err)
 void samplemap_free(samplemap *m)
 {
     free(m->records);
+    free(m->band);
     m->records = NULL;
+    m->band = NULL;
 }

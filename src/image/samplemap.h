@@ -16,7 +16,11 @@
    record count other than faces, chunk_faces not a positive multiple of packed_width, a crop
    outside the film, a film pixel outside the crop, an offset outside [0, 1] (float32 rounding
    may give 1), a weight that is negative or not finite, a string longer than its field, a
-   film of more than 2^32 pixels or chunk_faces above INT_MAX (POV-Ray counts faces in an int). */
+   film of more than 2^32 pixels or chunk_faces above INT_MAX (POV-Ray counts faces in an int).
+
+   With dispersion the header has the line "wavelength_bands N" (N = spp, after unit_mm; absent
+   without dispersion, so such maps are unchanged) and every record 4 bytes more: uint32 band,
+   the sample's wavelength band (spectrum.h), below N. */
 #ifndef LENS2POV_SAMPLEMAP_H
 #define LENS2POV_SAMPLEMAP_H
 
@@ -44,11 +48,13 @@ typedef struct samplemap_header {
     char pupil[32], trace[32], weighting[32];
     double f_number, aperture_diameter_mm, focus_distance_units, film_distance_mm;
     double film_diagonal_mm, unit_mm;
+    int wavelength_bands;          /* 0: no dispersion; else spp, and records carry a band */
 } samplemap_header;
 
 typedef struct samplemap {
     samplemap_header header;
     samplemap_record *records;     /* header.faces of them */
+    uint32_t *band;                /* each record's band with dispersion, else NULL */
 } samplemap;
 
 /* Number of chunks and the rows of chunk k's face layout (its image has one row more, see
@@ -60,11 +66,13 @@ long long samplemap_chunk_count(const samplemap_header *h);
 int samplemap_chunk_rows(const samplemap_header *h, long long chunk);
 
 /* Writing: reserve the header, append records, then write the header once faces is known.
-   Each returns L2P_OK or L2P_FAILED (see ferror / errno). samplemap_finish also fails when
+   band is NULL without dispersion, else each record's band. Each returns L2P_OK or L2P_FAILED
+   (see ferror / errno). samplemap_finish also fails when
    the records appended are not exactly h->faces or the header does not fit its 4096 bytes,
    and leaves the file position at the end. */
 int samplemap_begin(FILE *fp);
-int samplemap_append(FILE *fp, const samplemap_record *records, size_t count);
+int samplemap_append(FILE *fp, const samplemap_record *records, const uint32_t *band,
+                     size_t count);
 int samplemap_finish(FILE *fp, const samplemap_header *h);
 
 int samplemap_read(const char *path, samplemap *out, l2p_error *err);

@@ -85,10 +85,28 @@ static inline const lens_blades *lens_blades_of(const lens *l, int i)
     return i == l->stop && l->blades.count ? &l->blades : NULL;
 }
 
-/* Index of the medium behind surface s at this wavelength (nm): ior where the file gives no
-   Abbe number, else the Cauchy fit A + B / lambda^2 through n_d and V_d (lens.c,
-   docs/lenses.md). */
+/* Standard wavelengths of the Abbe number, nm: helium d, hydrogen F and C lines. */
+#define WAVELENGTH_D_NM 587.5618
+#define WAVELENGTH_F_NM 486.1327
+#define WAVELENGTH_C_NM 656.2725
+
+/* The medium behind surface s as n(lambda) = a + b / lambda^2 (lambda in nm): the Cauchy fit
+   through n_d and V_d (lens_shape.c, docs/lenses.md); a = ior and b = 0 where the file gives
+   no Abbe number. */
+void lens_cauchy(const lens_surface *s, double *a, double *b_nm2);
+
+/* 1 / lambda^2, the variable the Cauchy fit is linear in. */
+static inline double lens_inverse_square(double wavelength_nm)
+{
+    return 1.0 / (wavelength_nm * wavelength_nm);
+}
+
+/* Index of the medium behind surface s at this wavelength (nm): a + b / lambda^2. */
 double lens_index_at(const lens_surface *s, double wavelength_nm);
+
+/* Gives every surface its index at this wavelength, and no Abbe number: the lens as a light
+   of one wavelength sees it (for first-order properties and pupils at that wavelength). */
+void lens_at_wavelength(lens *l, double wavelength_nm);
 
 /* 1 when the file gave Abbe numbers (its glass rows have a fifth column), else 0. */
 int lens_has_abbe(const lens *l);

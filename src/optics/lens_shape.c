@@ -5,11 +5,6 @@
 #include <math.h>
 #include <string.h>
 
-/* Standard wavelengths of the Abbe number, nm: helium d, hydrogen F and C lines. */
-#define WAVELENGTH_D_NM 587.5618
-#define WAVELENGTH_F_NM 486.1327
-#define WAVELENGTH_C_NM 656.2725
-
 /* From the film forward: the rear vertex sits at the film distance, and each surface in front
    of it one thickness further. The last row's own thickness is not used. */
 void lens_set_film_distance(lens *l, double film_distance_mm)
@@ -37,15 +32,34 @@ double lens_total_length_mm(const lens *l)
          gives B = (n_d - 1) / (V_d (1/lambda_F^2 - 1/lambda_C^2)),
      n(lambda_d) = n_d
          gives A = n_d - B / lambda_d^2. */
+void lens_cauchy(const lens_surface *s, double *a, double *b_nm2)
+{
+    *a = s->ior;
+    *b_nm2 = 0.0;
+    if (s->abbe == 0.0)
+        return;
+    const double inv_f2 = 1.0 / (WAVELENGTH_F_NM * WAVELENGTH_F_NM);
+    const double inv_c2 = 1.0 / (WAVELENGTH_C_NM * WAVELENGTH_C_NM);
+    *b_nm2 = (s->ior - 1.0) / (s->abbe * (inv_f2 - inv_c2));
+    *a = s->ior - *b_nm2 / (WAVELENGTH_D_NM * WAVELENGTH_D_NM);
+}
+
+/* As the lane tracer computes it (trace_lanes.h): A + B x with x = 1 / lambda^2. */
 double lens_index_at(const lens_surface *s, double wavelength_nm)
 {
     if (s->abbe == 0.0)
         return s->ior;
-    const double inv_f2 = 1.0 / (WAVELENGTH_F_NM * WAVELENGTH_F_NM);
-    const double inv_c2 = 1.0 / (WAVELENGTH_C_NM * WAVELENGTH_C_NM);
-    const double b = (s->ior - 1.0) / (s->abbe * (inv_f2 - inv_c2));
-    const double a = s->ior - b / (WAVELENGTH_D_NM * WAVELENGTH_D_NM);
-    return a + b / (wavelength_nm * wavelength_nm);
+    double a, b;
+    lens_cauchy(s, &a, &b);
+    return a + b * lens_inverse_square(wavelength_nm);
+}
+
+void lens_at_wavelength(lens *l, double wavelength_nm)
+{
+    for (int i = 0; i < l->count; i++) {
+        l->surface[i].ior = lens_index_at(&l->surface[i], wavelength_nm);
+        l->surface[i].abbe = 0.0;
+    }
 }
 
 int lens_has_abbe(const lens *l)

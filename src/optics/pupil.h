@@ -66,6 +66,13 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err);
    divides by the sampling density. */
 void pupil_fit(pupil *pu, const lens *l, double film_radius_mm);
 
+/* Grows a fitted pupil so that it also holds every ray that lens l passes: l is the same lens
+   at another wavelength (lens_at_wavelength), whose passing regions are those of the fit
+   moved and scaled a little. Each node, and each point the fit checks between nodes, grows
+   by what it falls short, with the fit's margin; the reach moves out where l passes rays
+   beyond it. Does nothing to a pupil that was not fitted. */
+void pupil_cover(pupil *pu, const lens *l);
+
 /* The shape sampled for a film point at film radius r_mm (the frame of pupil_shape); false
    when no ray from there gets through the lens. */
 bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out);

@@ -360,3 +360,46 @@ void pupil_fit(pupil *pu, const lens *l, double film_radius_mm)
     for (int j = 0; j <= PUPIL_NODES; j++)
         grow(&pu->node[j], MARGIN);
 }
+
+/* Beyond the reach, lens l may still pass rays a little farther out: the reach is bisected
+   again, out to the next node, when l passes rays at the old one. */
+static void extend_reach(pupil *pu, const lens *l)
+{
+    if (!isfinite(pu->reach_mm))
+        return;
+    pupil_shape e;
+    pupil_shape_at(pu, pu->reach_mm, &e);
+    double in = pu->reach_mm, out = in + pu->node_spacing_mm;
+    if (!find_region(pu, l, in, e.centre_mm, size_of(&e)).found)
+        return;
+    if (find_region(pu, l, out, e.centre_mm, size_of(&e)).found) {
+        pu->reach_mm = INFINITY;   /* as find_reach does when the region outlives the search */
+        return;
+    }
+    for (int k = 0; k < 24; k++) {
+        const double mid = 0.5 * (in + out);
+        *(find_region(pu, l, mid, e.centre_mm, size_of(&e)).found ? &in : &out) = mid;
+    }
+    pu->reach_mm = out;
+}
+
+void pupil_cover(pupil *pu, const lens *l)
+{
+    if (!(pu->node_spacing_mm > 0.0))
+        return;
+    extend_reach(pu, l);
+    for (int j = 0; j <= PUPIL_NODES; j++)
+        for (int c = 0; c <= CHECKS && (c == 0 || j < PUPIL_NODES); c++) {
+            const double r = (j + (double)c / (CHECKS + 1)) * pu->node_spacing_mm;
+            pupil_shape e;
+            if (!pupil_shape_at(pu, r, &e))
+                continue;
+            const region g = find_region(pu, l, r, e.centre_mm, size_of(&e));
+            const double factor = g.found ? shortfall(&e, &g) : 1.0;
+            if (factor <= 1.0)
+                continue;
+            grow(&pu->node[j], factor * MARGIN);
+            if (c > 0)
+                grow(&pu->node[j + 1], factor * MARGIN);
+        }
+}

@@ -23,10 +23,16 @@ trace_status trace_refract(vec3 n, double n1, double n2, vec3 *d)
 
 trace_status trace_toward_scene(const lens *l, int first, int last, ray *r, int *blocked_at)
 {
-    return kernel_through(l, first, last, true, r, blocked_at);
+    return kernel_through(l, first, last, true, 0.0, r, blocked_at);
+}
+
+trace_status trace_toward_scene_at(const lens *l, int first, int last, double wavelength_nm,
+                                   ray *r, int *blocked_at)
+{
+    return kernel_through(l, first, last, true, wavelength_nm, r, blocked_at);
 }
 
 trace_status trace_toward_film(const lens *l, int first, int last, ray *r, int *blocked_at)
 {
-    return kernel_through(l, first, last, false, r, blocked_at);
+    return kernel_through(l, first, last, false, 0.0, r, blocked_at);
 }

@@ -46,4 +46,8 @@ trace_status trace_refract(vec3 n, double n1, double n2, vec3 *d);
 trace_status trace_toward_scene(const lens *l, int first, int last, ray *r, int *blocked_at);
 trace_status trace_toward_film(const lens *l, int first, int last, ray *r, int *blocked_at);
 
+/* trace_toward_scene with the indices at this wavelength (nm), n(lambda) of lens_index_at. */
+trace_status trace_toward_scene_at(const lens *l, int first, int last, double wavelength_nm,
+                                   ray *r, int *blocked_at);
+
 #endif

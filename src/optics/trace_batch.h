@@ -20,6 +20,11 @@ typedef struct trace_batch {
    best instruction set this processor has. Unit directions out. */
 void trace_batch_toward_scene(const lens *l, trace_batch *b, int n);
 
+/* The same with each ray's wavelength (nm; NULL: the file's indices), every medium's index
+   n(lambda) of lens_index_at. Bit for bit what trace_toward_scene_at gives one ray. */
+void trace_batch_toward_scene_at(const lens *l, trace_batch *b, int n,
+                                 const double *wavelength_nm);
+
 /* The instruction set in use ("avx512", "avx2", "sse2" or "scalar", the one-ray kernel). */
 const char *trace_batch_isa(void);
 

@@ -140,13 +140,19 @@ INLINE vmask within_blades(const lens_blades *b, real a2, vreal x, vreal y)
     return le(far, splat(sqrt(a2) * b->apothem_ratio));
 }
 
+/* The index n = a + b x of a medium (lens_cauchy) for each lane's x = 1 / lambda^2. */
+INLINE vreal index_at(real a, real b_nm2, vreal x)
+{
+    return add(splat(a), mul(splat(b_nm2), x));
+}
+
 /* One surface for the rays o, d of the lanes `alive`: the intersection, the clear aperture
    (or the stop's opening) of squared radius a2, and within it the blades' polygon when there
-   are blades, refraction with eta = n1 / n2 (none where eta = 1). A ray that gets through
-   moves to the surface with its new direction; one that does not stays as it was and gets its
-   status. Returns the lanes still alive. */
-INLINE unsigned cross(const lens_surface *s, real a2, const lens_blades *blades, real eta,
-                      vreal o[3], vreal d[3], long long *status, unsigned alive)
+   are blades, then, when it refracts, refraction with each lane's eta = n1 / n2. A ray that
+   gets through moves to the surface with its new direction; one that does not stays as it was
+   and gets its status. Returns the lanes still alive. */
+INLINE unsigned cross(const lens_surface *s, real a2, const lens_blades *blades, bool refracts,
+                      vreal eta, vreal o[3], vreal d[3], long long *status, unsigned alive)
 {
     vreal h[3], e[3];
     const vmask hit = intersect(s, o, d, h);
@@ -154,12 +160,11 @@ INLINE unsigned cross(const lens_surface *s, real a2, const lens_blades *blades,
     if (blades)
         inside = mand(inside, within_blades(blades, a2, h[0], h[1]));
     unsigned tir = 0, grazing = 0;
-    const bool refracts = eta != 1;
     if (refracts) {
         vreal n[3];
         vmask t, g;
         normal_at(s, h, n);
-        refract(n, splat(eta), d, e, &t, &g);
+        refract(n, eta, d, e, &t, &g);
         tir = bits(t);
         grazing = bits(g);
     }

@@ -75,19 +75,23 @@ static trace_status KNAME(refract)(KVEC n, KREAL n1, KREAL n2, KVEC *d)
     return TRACE_PASSED;
 }
 
-/* Surfaces last .. first toward the scene (+z), or first .. last toward the film. A blocked
-   ray stays on the last surface it crossed. */
+/* Surfaces last .. first toward the scene (+z), or first .. last toward the film, with the
+   indices at this wavelength (nm; 0: the file's n_d). A blocked ray stays on the last surface
+   it crossed. */
 static trace_status KNAME(through)(const lens *l, int first, int last, bool toward_scene,
-                                   KRAY *r, int *blocked_at)
+                                   double wavelength_nm, KRAY *r, int *blocked_at)
 {
     vreal o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
     long long status = TRACE_PASSED;
     const int step = toward_scene ? -1 : 1;
     for (int i = toward_scene ? last : first; i >= first && i <= last; i += step) {
-        const real front = lens_ior_front(l, i), behind = lens_ior_behind(l, i);
-        const real a = lens_semi_aperture_mm(l, i);
-        if (!cross(&l->surface[i], a * a, lens_blades_of(l, i),
-                   toward_scene ? behind / front : front / behind, o, d, &status, 1)) {
+        real front = lens_ior_front(l, i), behind = lens_ior_behind(l, i);
+        if (wavelength_nm > 0) {
+            front = i == 0 ? 1.0 : lens_index_at(&l->surface[i - 1], wavelength_nm);
+            behind = lens_index_at(&l->surface[i], wavelength_nm);
+        }
+        const real a = lens_semi_aperture_mm(l, i), eta = toward_scene ? behind / front : front / behind;
+        if (!cross(&l->surface[i], a * a, lens_blades_of(l, i), eta != 1, eta, o, d, &status, 1)) {
             if (blocked_at)
                 *blocked_at = i;
             break;

@@ -283,8 +283,11 @@ static int open_side_files(povmesh_emitter *e, const char *csv_path, l2p_error *
     e->has_csv = true;
     if ((st = text_open(&e->csv, csv_path, err)) != 0)
         return st;
-    text_put_str(&e->csv, "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
-                     "dir_x,dir_y,dir_z,weight\n");
+    text_put_str(&e->csv, e->cam->dispersion
+                              ? "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
+                                "dir_x,dir_y,dir_z,weight,wavelength_nm\n"
+                              : "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
+                                "dir_x,dir_y,dir_z,weight\n");
     return L2P_OK;
 }
 
@@ -317,12 +320,17 @@ int povmesh_open(povmesh_emitter **out, const camera *c, const char *prefix, con
 
 bool povmesh_wants_csv(const povmesh_emitter *e) { return e->has_csv; }
 
-static size_t put_csv(char *csv, const emitted_ray *r)
+/* A row of the CSV; the wavelength column only with dispersion. */
+static size_t put_csv(char *csv, const emitted_ray *r, bool dispersion)
 {
-    return (size_t)snprintf(csv, POVMESH_CSV_MAX,
-        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+    int n = snprintf(csv, POVMESH_CSV_MAX,
+        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
         r->px + r->offset_x, r->py + r->offset_y, r->film_point.x, r->film_point.y,
         r->out.o.x, r->out.o.y, r->out.o.z, r->out.d.x, r->out.d.y, r->out.d.z, r->weight);
+    if (dispersion)
+        n += snprintf(csv + n, POVMESH_CSV_MAX - (size_t)n, ",%.17g", r->wavelength_nm);
+    n += snprintf(csv + n, POVMESH_CSV_MAX - (size_t)n, "\n");
+    return (size_t)n;
 }
 
 void povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n,
@@ -338,8 +346,9 @@ void povmesh_format_rays(const povmesh_emitter *e, const emitted_ray *r, int n,
         f->record[f->count] = (samplemap_record){
             (uint32_t)r[i].py * (uint32_t)e->cam->film.width + (uint32_t)r[i].px,
             (float)r[i].offset_x, (float)r[i].offset_y, (float)r[i].weight};
+        f->band[f->count] = (uint32_t)r[i].band;
         if (e->has_csv) {
-            f->csv_length[f->count] = put_csv(f->csv + f->csv_len, &r[i]);
+            f->csv_length[f->count] = put_csv(f->csv + f->csv_len, &r[i], e->cam->dispersion);
             f->csv_len += f->csv_length[f->count];
         }
     }
@@ -370,8 +379,8 @@ static int put_face(povmesh_emitter *e, chunk *ch, const char *text, size_t len,
 }
 
 static int append_face(povmesh_emitter *e, const char *text, size_t len, unsigned kind,
-                       const samplemap_record *rec, const char *csv, size_t csv_len,
-                       l2p_error *err)
+                       const samplemap_record *rec, const uint32_t *band, const char *csv,
+                       size_t csv_len, l2p_error *err)
 {
     int st;
     chunk *ch = &e->chunks[e->chunk_count - 1];
@@ -383,7 +392,7 @@ static int append_face(povmesh_emitter *e, const char *text, size_t len, unsigne
     if ((st = put_face(e, ch, text, len, kind, err)) != 0)
         return st;
     e->faces++;
-    if (samplemap_append(e->map.fp, rec, 1) != 0)
+    if (samplemap_append(e->map.fp, rec, e->cam->dispersion ? band : NULL, 1) != 0)
         return l2p_fail(err, L2P_FAILED, e->map.final_path, 0, "write failed");
     if (!e->has_csv)
         return L2P_OK;
@@ -399,7 +408,7 @@ int povmesh_append(povmesh_emitter *e, const formatted_faces *f, l2p_error *err)
     for (long long i = 0; i < f->count; i++) {
         const size_t csv_len = e->has_csv ? f->csv_length[i] : 0;
         int st = append_face(e, f->text + at, f->length[i], f->kind[i], &f->record[i],
-                             f->csv + csv_at, csv_len, err);
+                             &f->band[i], f->csv + csv_at, csv_len, err);
         if (st)
             return st;
         at += f->length[i];
@@ -429,6 +438,7 @@ void povmesh_camera_header(const camera *c, samplemap_header *h)
     h->film_distance_mm = c->lens.film_distance_mm;
     h->film_diagonal_mm = c->film.diagonal_mm;
     h->unit_mm = c->unit_mm;
+    h->wavelength_bands = c->dispersion ? c->samples.spp : 0;
 }
 
 static void fill_map_header(const povmesh_emitter *e, samplemap_header *h)

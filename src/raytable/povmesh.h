@@ -21,6 +21,8 @@ typedef struct emitted_ray {
     vec3 film_point;            /* camera space, mm */
     ray out;                    /* camera space, mm, origin on the lens's front */
     double weight;
+    int band;                   /* with dispersion: the wavelength's band (spectrum.h) */
+    double wavelength_nm;       /* with dispersion, else not read */
 } emitted_ray;
 
 typedef struct povmesh_emitter povmesh_emitter;
@@ -38,15 +40,16 @@ int povmesh_open(povmesh_emitter **e, const camera *c, const char *prefix, const
    Neighbouring rays share a triangle edge where float32 can hold them as well as alone (see
    povface.h): four vertices for two faces, which POV-Ray parses in two thirds of the time.
    A face's kind (enum face_kind, facelist.h) tells the appender where its vertices are. */
-enum { POVMESH_RAY_TEXT_MAX = 512, POVMESH_CSV_MAX = 512 };
+enum { POVMESH_RAY_TEXT_MAX = 512, POVMESH_CSV_MAX = 560 };
 
 /* Faces formatted and not yet appended, in face order: each one's vertex text (one after the
-   other), its kind, its sample-map record and, when the emitter writes CSV, its CSV row. */
+   other), its kind, its sample-map record and band and, when the emitter writes CSV, its CSV row. */
 typedef struct formatted_faces {
     char *text;
     size_t text_len, *length;
     unsigned char *kind;
     samplemap_record *record;
+    uint32_t *band;             /* each face's wavelength band (read with dispersion only) */
     char *csv;
     size_t csv_len, *csv_length;
     long long count;

@@ -41,9 +41,11 @@ static int row_reserve(row_out *o, long long rays, bool csv)
     f->length = malloc(n * sizeof *f->length + 1);
     f->kind = malloc(n + 1);
     f->record = malloc(n * sizeof *f->record + 1);
+    f->band = malloc(n * sizeof *f->band + 1);
     f->csv = malloc((csv ? n * POVMESH_CSV_MAX : 0) + 1);
     f->csv_length = malloc(n * sizeof *f->csv_length + 1);
-    return f->text && f->length && f->kind && f->record && f->csv && f->csv_length ? 0 : -1;
+    return f->text && f->length && f->kind && f->record && f->band && f->csv && f->csv_length
+               ? 0 : -1;
 }
 
 static void row_free(row_out *o)
@@ -53,6 +55,7 @@ static void row_free(row_out *o)
     free(f->length);
     free(f->kind);
     free(f->record);
+    free(f->band);
     free(f->csv);
     free(f->csv_length);
 }
@@ -97,12 +100,17 @@ static void trace_row(const camera *c, const povmesh_emitter *e, int py, batch *
                                                             py + s.offset_y);
             if (!pupil_reaches(&c->pupil, film_point))
                 continue;   /* no ray from there gets through: not a sample to trace */
-            const int k = b->s.n;
-            b->r[k] = (emitted_ray){.px = px, .py = py, .offset_x = s.offset_x,
+            const int n = b->s.n;
+            b->r[n] = (emitted_ray){.px = px, .py = py, .offset_x = s.offset_x,
                                     .offset_y = s.offset_y, .film_point = film_point};
-            b->s.film_point[k] = film_point;
-            b->s.u[k] = s.pupil_u;
-            b->s.v[k] = s.pupil_v;
+            b->s.film_point[n] = film_point;
+            b->s.u[n] = s.pupil_u;
+            b->s.v[n] = s.pupil_v;
+            if (c->dispersion) {
+                const wavelength_sample w = sample_pattern_wavelength(&c->samples, pixel, k);
+                b->r[n].band = w.band;
+                b->r[n].wavelength_nm = b->s.wavelength_nm[n] = w.nm;
+            }
             if (++b->s.n == CAMERA_BATCH)
                 flush_batch(c, e, b, o);
         }
