@@ -12,6 +12,7 @@
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "image/samplemap.h"
+#include "optics/spectrum.h"
 #include "support.h"
 
 static double srgb_decode(double v)
@@ -755,4 +756,96 @@ Test(image_io, grey_file_read_as_rgba)
         cr_assert_eq(px[4 * i + 3], 1.0f);
     }
     free(px);
+}
+
+/* ---- dispersion: bands in the map, colour in developing ---- */
+
+/* With wavelength bands every record carries one (4 bytes more), the header says how many,
+   and they come back as written; a band outside them, or a band count other than spp, is
+   refused. */
+Test(samplemap, bands_round_trip_and_are_checked)
+{
+    const char *dir = test_tmpdir();
+    samplemap m;
+    make_map(&m);
+    m.header.wavelength_bands = m.header.spp;
+    uint32_t band[FACES];
+    for (int k = 0; k < FACES; k++)
+        band[k] = (uint32_t)(k % m.header.spp);
+    const char *path = tmp_path(dir, "bands.map");
+    FILE *fp = fopen(path, "wb");
+    cr_assert_eq(samplemap_begin(fp), L2P_OK);
+    cr_assert_eq(samplemap_append(fp, m.records, band, FACES), L2P_OK);
+    cr_assert_eq(samplemap_finish(fp, &m.header), L2P_OK);
+    fclose(fp);
+    struct stat st;
+    cr_assert_eq(stat(path, &st), 0);
+    cr_assert_eq(st.st_size, SAMPLEMAP_HEADER_BYTES + 20 * FACES);
+    samplemap r;
+    l2p_error err = {0, ""};
+    cr_assert_eq(samplemap_read(path, &r, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(r.header.wavelength_bands, m.header.spp);
+    cr_assert_not_null(r.band);
+    cr_assert_eq(memcmp(r.band, band, sizeof band), 0);
+    cr_assert_eq(memcmp(r.records, m.records, sizeof *m.records * FACES), 0);
+    samplemap_free(&r);
+
+    band[FACES - 1] = (uint32_t)m.header.spp;   /* one past the last band */
+    fp = fopen(path, "wb");
+    samplemap_begin(fp);
+    samplemap_append(fp, m.records, band, FACES);
+    samplemap_finish(fp, &m.header);
+    fclose(fp);
+    cr_assert_eq(samplemap_read(path, &r, &err), L2P_BAD_INPUT);
+    cr_assert(strstr(err.text, "band"), "%s", err.text);
+
+    m.header.wavelength_bands = m.header.spp + 1;
+    band[FACES - 1] = 0;
+    fp = fopen(path, "wb");
+    samplemap_begin(fp);
+    samplemap_append(fp, m.records, band, FACES);
+    samplemap_finish(fp, &m.header);
+    fclose(fp);
+    cr_assert_eq(samplemap_read(path, &r, &err), L2P_BAD_INPUT);
+    cr_assert(strstr(err.text, "wavelength_bands"), "%s", err.text);
+    samplemap_free(&m);
+}
+
+/* Developing with bands, worked by hand: a pixel's channel is (sum of weights) / spp times its
+   radiances averaged with weight x band weight; where that denominator falls below a quarter
+   of the weights, the plain weighted mean. */
+Test(develop, dispersion_renormalizes_the_band_weights)
+{
+    samplemap_header h;
+    memset(&h, 0, sizeof h);
+    h.film_width = 2, h.film_height = 1, h.spp = 4, h.crop_x1 = 2, h.crop_y1 = 1;
+    h.wavelength_bands = 4;
+    samplemap m = {.header = h};
+    double colour[4][3];
+    for (int b = 0; b < 4; b++)
+        spectrum_band_weights(b, 4, colour[b]);
+    double sums[2 * 10] = {0};
+    /* pixel 0: bands 0, 1, 3 pass with weights 1, 0.5, 2 and colours (1, 1, 1), (0, 2, 4),
+       (3, 0, 1); band 2 is blocked */
+    const float rgba[3][4] = {{1, 1, 1, 1}, {0, 2, 4, 1}, {3, 0, 1, 1}};
+    const int bands[3] = {0, 1, 3};
+    const double weights[3] = {1, 0.5, 2};
+    for (int k = 0; k < 3; k++)
+        develop_add(sums, colour[bands[k]], weights[k], rgba[k]);
+    /* pixel 1: a white sample in band 1 alone */
+    develop_add(sums + 10, colour[1], 1.0, rgba[0]);
+    float rgb[6];
+    develop_finish(&m, sums, rgb);
+    for (int c = 0; c < 3; c++) {
+        double num = 0, den = 0, plain = 0;
+        for (int k = 0; k < 3; k++) {
+            num += weights[k] * colour[bands[k]][c] * rgba[k][c];
+            den += weights[k] * colour[bands[k]][c];
+            plain += weights[k] * rgba[k][c];
+        }
+        const double radiance = den >= 0.25 * 3.5 ? num / den : plain / 3.5;
+        cr_expect(fabs(rgb[c] - 3.5 / 4 * radiance) < 1e-6 * fabs(radiance) + 1e-7,
+                  "channel %d: %g, by hand %g", c, rgb[c], 3.5 / 4 * radiance);
+        cr_expect(fabs(rgb[3 + c] - 0.25f) < 1e-7, "a white sample alone stays white: %g", rgb[3 + c]);
+    }
 }

@@ -236,3 +236,31 @@ Test(plot, bad_requests_exit_2_and_a_missing_gnuplot_1)
     free(err);
     cr_assert_not(file_exists(png));
 }
+
+/* With blades the section cuts the stop where the polygon reaches: 5 blades with a corner at
+   +y (rotation 90) reach the full radius R above the axis and the apothem R cos(36 deg) below;
+   a round stop reaches R both ways. */
+Test(diagram, the_stop_is_drawn_as_the_blades_cut_it)
+{
+    const char *dir = test_tmpdir();
+    const char *svg_path = tmp_path(dir, "blades.svg");
+    for (int blades = 0; blades < 2; blades++) {
+        run_lens2pov_ok("diagram", "diagram", "dgauss.50mm", "--f-number", "4",
+                        "--aperture-blades", blades ? "5" : "0", "--blade-rotation", "90", "-o",
+                        svg_path, NULL);
+        char *svg = read_text(svg_path, NULL);
+        const char *stop = strstr(svg, "class=\"stop\" d=\"M ");
+        cr_assert_not_null(stop);
+        double z0, above, z1, outer, z2, below;
+        cr_assert_eq(sscanf(stop, "class=\"stop\" d=\"M %lf,%lf L %lf,%lf M %lf,%lf", &z0, &above,
+                            &z1, &outer, &z2, &below), 6);
+        const double r = above;   /* a corner: the opening's radius */
+        if (blades)
+            cr_expect(fabs(-below - r * cos(M_PI / 5)) < 1e-9 * r,
+                      "below the axis the stop reaches %g, the apothem is %g", -below,
+                      r * cos(M_PI / 5));
+        else
+            cr_expect(fabs(-below - r) < 1e-12 * r, "round: %g and %g", above, -below);
+        free(svg);
+    }
+}

@@ -27,6 +27,7 @@
 
 extern char **environ;
 
+#define COOKE LENS_DIR "cooke-triplet.50mm.dat"
 #define DGAUSS LENS_DIR "dgauss.50mm.dat"
 
 /* Files in dir other than those listed (NULL-terminated); returns how many, and names the
@@ -139,6 +140,14 @@ static const bad_line BAD_OPTIONS[] = {
     {{"trace", DGAUSS, "--aperture-blades", "-1", "-o", "OUT"}, "--aperture-blades"},
     {{"trace", DGAUSS, "--blade-rotation", "x", "-o", "OUT"}, "--blade-rotation"},
     {{"trace", DGAUSS, "--aperture-blades", "6", "--trace", "thick", "-o", "OUT"}, "--trace full"},
+    /* dispersion and wavelengths */
+    {{"trace", DGAUSS, "--dispersion", "on", "-o", "OUT"}, "Abbe numbers"},
+    {{"trace", COOKE, "--dispersion", "on", "--trace", "thick", "-o", "OUT"}, "--trace full"},
+    {{"trace", COOKE, "--dispersion", "yes", "-o", "OUT"}, "--dispersion"},
+    {{"trace", COOKE, "--wavelength", "500", "--dispersion", "on", "-o", "OUT"}, "--wavelength"},
+    {{"info", COOKE, "--wavelength", "200"}, "--wavelength"},
+    {{"info", COOKE, "--wavelength", "nan"}, "--wavelength"},
+    {{"info", COOKE, "--dispersion", "on"}, "does not take --dispersion"},
     /* the command line itself */
     {{"trace", DGAUSS, "--frobnicate", "1", "-o", "OUT"}, "--frobnicate"},
     {{"trace", DGAUSS, "-o"}, "-o"},

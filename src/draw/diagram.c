@@ -140,11 +140,18 @@ static void draw_elements(FILE *out, const lens *l)
     }
 }
 
+/* Two bars, from the opening at `above` (+y) and `below` (-y) of the axis out to `outer`. */
+static void draw_bars_apart(FILE *out, const char *class, double z, double above, double below,
+                            double outer)
+{
+    fprintf(out, "<path class=\"%s\" d=\"M %.12g,%.12g L %.12g,%.12g M %.12g,%.12g L %.12g,%.12g\"/>\n",
+            class, z, above, z, outer, z, -below, z, -outer);
+}
+
 /* Two bars from the opening out to the stop's largest opening and a little beyond. */
 static void draw_bars(FILE *out, const char *class, double z, double inner, double outer)
 {
-    fprintf(out, "<path class=\"%s\" d=\"M %.12g,%.12g L %.12g,%.12g M %.12g,%.12g L %.12g,%.12g\"/>\n",
-            class, z, inner, z, outer, z, -inner, z, -outer);
+    draw_bars_apart(out, class, z, inner, inner, outer);
 }
 
 static void draw_rays(FILE *out, const scene *s)
@@ -211,7 +218,9 @@ static void draw(FILE *out, const scene *s)
     fprintf(out, "<line class=\"axis\" x1=\"%.12g\" y1=\"0\" x2=\"%.12g\" y2=\"0\"/>\n", v->zmin, v->zmax);
     draw_elements(out, l);
     const double a = lens_semi_aperture_mm(l, l->stop), big = 0.5 * l->surface[l->stop].aperture_diameter_mm;
-    draw_bars(out, "stop", l->surface[l->stop].vertex_z_mm, a, fmax(a, big) + 0.1 * v->ymax);
+    /* the section (x = 0) cuts blades where the polygon reaches along +y and -y */
+    draw_bars_apart(out, "stop", l->surface[l->stop].vertex_z_mm, lens_stop_reach_mm(l, 0, 1),
+                    lens_stop_reach_mm(l, 0, -1), fmax(a, big) + 0.1 * v->ymax);
     draw_bars(out, "pupil", s->ep_z, s->ep_r, s->ep_r + 0.04 * v->ymax);
     draw_bars(out, "pupil", s->xp_z, s->xp_r, s->xp_r + 0.04 * v->ymax);
     const double film = 0.5 * s->c->film.diagonal_mm;

@@ -19,7 +19,7 @@
 typedef struct sub {
     field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
     float *weights;            /* one a crop pixel, while building; then in its file */
-    double colour[3];          /* its wavelength band's colour weights; 1 without dispersion */
+    double colour[3];          /* its wavelength band's colour weights, with dispersion */
     field_stats stats;
     int render, dx, dy;        /* where it is rendered */
 } sub;
@@ -85,7 +85,6 @@ static int load_weights(const char *dir, int k, float *weights, size_t n, l2p_er
 static film_sample shared_sample(const camera *c, int k, double colour[3])
 {
     film_sample s = sobol_shared_sample(c->samples.seed, (uint32_t)k);
-    colour[0] = colour[1] = colour[2] = 1.0;
     if (c->dispersion) {
         const wavelength_sample w = sample_pattern_wavelength(&c->samples,
                                                               sample_pattern_shared(&c->samples), k);
@@ -247,7 +246,7 @@ static int write_render(const camera *c, const sub *subs, const render_plan *p, 
 /* ---------------------------------------------------------------- developing */
 
 static int develop_render(const render_plan *p, const sub *subs, const char *exr, const char *dir,
-                          int w, int h, double *sums, l2p_error *err)
+                          int w, int h, size_t stride, double *sums, l2p_error *err)
 {
     int iw, ih;
     float *rgba, *weights = malloc(sizeof *weights * (size_t)w * h);
@@ -272,8 +271,8 @@ static int develop_render(const render_plan *p, const sub *subs, const char *exr
                 if (wt <= 0)
                     continue;   /* blocked: no face, black */
                 const float *px = rgba + 4 * ((size_t)(s->dy + y + 1) * iw + s->dx + x);
-                for (int ch = 0; ch < 3; ch++)
-                    sums[3 * ((size_t)y * w + x) + ch] += (double)wt * s->colour[ch] * px[ch];
+                develop_add(sums + stride * ((size_t)y * w + x), stride > 3 ? s->colour : NULL,
+                            (double)wt, px);
             }
     }
     free(rgba), free(weights);
@@ -305,16 +304,16 @@ static int render_and_develop(const camera *c, const field_render_options *o, su
                                .film_height = c->film.height};
     if (!st)
         st = povray_render_chunks(ch, renders, &po, err);
-    double *sums = st ? NULL : calloc(3 * (size_t)w * h, sizeof *sums);
+    samplemap map = {.records = NULL};
+    povmesh_camera_header(c, &map.header);
+    const size_t stride = develop_sums_per_pixel(&map.header);
+    double *sums = st ? NULL : calloc(stride * (size_t)w * h, sizeof *sums);
     if (!st && !sums)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int r = 0; r < renders && !st; r++)
-        st = develop_render(&plans[r], subs, ch[r].output_exr, o->work_dir, w, h, sums, err);
-    if (!st) {
-        samplemap map = {.records = NULL};
-        povmesh_camera_header(c, &map.header);
+        st = develop_render(&plans[r], subs, ch[r].output_exr, o->work_dir, w, h, stride, sums, err);
+    if (!st)
         st = develop_write_picture(&map, sums, o->output, err);
-    }
     free(sums);
     for (int r = 0; ch && r < renders; r++)
         free((char *)ch[r].include_path), free((char *)ch[r].ini_path), free((char *)ch[r].output_exr);

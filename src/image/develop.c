@@ -50,8 +50,27 @@ static double (*band_weights(const samplemap_header *h))[3]
     return w;
 }
 
-/* Adds face's colour into its film pixel: its weight times each channel, and with dispersion
-   times its band's weight of that channel. */
+size_t develop_sums_per_pixel(const samplemap_header *h)
+{
+    return h->wavelength_bands > 0 ? 10 : 3;
+}
+
+void develop_add(double *pixel, const double *colour, double weight, const float *rgba)
+{
+    if (!colour) {
+        for (int c = 0; c < 3; c++)
+            pixel[c] += weight * (double)rgba[c];
+        return;
+    }
+    for (int c = 0; c < 3; c++) {
+        pixel[c] += weight * colour[c] * (double)rgba[c];
+        pixel[3 + c] += weight * colour[c];
+        pixel[6 + c] += weight * (double)rgba[c];
+    }
+    pixel[9] += weight;
+}
+
+/* Adds face's colour into its film pixel. */
 static int add_sample(const samplemap *map, const double (*colour)[3], long long face,
                       const float *rgba, double *sums, l2p_error *err)
 {
@@ -60,10 +79,8 @@ static int add_sample(const samplemap *map, const double (*colour)[3], long long
     if (i < 0)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "face %lld: film pixel %lu outside the crop",
                         face, (unsigned long)r->film_pixel);
-    static const double white[3] = {1.0, 1.0, 1.0};
-    const double *w = colour ? colour[map->band[face]] : white;
-    for (int c = 0; c < 3; c++)
-        sums[3 * i + c] += (double)r->weight * w[c] * (double)rgba[c];
+    develop_add(sums + develop_sums_per_pixel(&map->header) * (size_t)i,
+                colour ? colour[map->band[face]] : NULL, (double)r->weight, rgba);
     return L2P_OK;
 }
 
@@ -91,12 +108,35 @@ int develop_accumulate(const samplemap *map, long long chunk, const float *rgba,
     return st;
 }
 
+/* With dispersion, channel c of a pixel is the irradiance sum(w) / spp times the radiance
+   averaged with the weights w b_c (b_c the sample's band weight): sum(w b_c L_c) / sum(w b_c).
+   Over all spp bands the b_c average 1 exactly, but a blocked sample (w = 0) takes its band
+   out, and band weights span about -3 to 5: sum(w b_c L_c) / spp alone would tint a white
+   pixel by up to a third at 16 spp for one blocked sample. This way a scene of one colour
+   keeps it exactly wherever samples are blocked, and the fringes of dispersion (L_c varying
+   with the band) stay; what it drops is the colour of vignetting that differs with
+   wavelength, a fraction of a percent for real lenses. Where sum(w b_c) is below a quarter of
+   sum(w) (few samples pass, in bands of small or negative weight) the average is no longer a
+   mean of the samples' radiances, and the plain weighted mean sum(w L_c) / sum(w) is taken. */
+static double dispersed(const double *pixel, int c, int spp)
+{
+    const double weight = pixel[9], band_weight = pixel[3 + c];
+    if (!(weight > 0))
+        return 0.0;
+    const double radiance = band_weight >= 0.25 * weight ? pixel[c] / band_weight
+                                                         : pixel[6 + c] / weight;
+    return weight / spp * radiance;
+}
+
 void develop_finish(const samplemap *map, const double *sums, float *rgb)
 {
     const samplemap_header *h = &map->header;
-    const size_t n = 3 * (size_t)crop_width(h) * (size_t)crop_height(h);
-    for (size_t i = 0; i < n; i++)
-        rgb[i] = (float)(sums[i] / h->spp);
+    const size_t pixels = (size_t)crop_width(h) * (size_t)crop_height(h);
+    const size_t stride = develop_sums_per_pixel(h);
+    for (size_t i = 0; i < pixels; i++)
+        for (int c = 0; c < 3; c++)
+            rgb[3 * i + c] = (float)(stride == 3 ? sums[3 * i + c] / h->spp
+                                                 : dispersed(sums + stride * i, c, h->spp));
 }
 
 /* ---- the whole step ---- */
@@ -180,7 +220,8 @@ int develop_files(const samplemap *map, const char *const *renders, int render_c
                         "the sample map has %lld chunk%s but %d render%s given", chunks,
                         chunks == 1 ? "" : "s", render_count,
                         render_count == 1 ? " was" : "s were");
-    double *sums = calloc(3 * (size_t)crop_width(h) * (size_t)crop_height(h), sizeof *sums);
+    double *sums = calloc(develop_sums_per_pixel(h) * (size_t)crop_width(h) * (size_t)crop_height(h),
+                          sizeof *sums);
     if (!sums)
         return l2p_fail(err, L2P_FAILED, out_path, 0, "out of memory");
     int st = L2P_OK;

@@ -5,9 +5,17 @@
 #include "base/error.h"
 #include "image/samplemap.h"
 
+/* The doubles sums holds a crop pixel: 3 (weight * colour), or with dispersion 10 (weight *
+   band weight * colour, weight * band weight, weight * colour, weight). */
+size_t develop_sums_per_pixel(const samplemap_header *h);
+
+/* Adds one sample of this weight and rendered colour into a pixel's sums; colour is its
+   wavelength band's colour weights (spectrum.h), NULL without dispersion. */
+void develop_add(double *pixel, const double *colour, double weight, const float *rgba);
+
 /* Accumulates one rendered chunk image (RGBA, its first row being the row work-around's
-   duplicate, dropped) into sums of weight * colour per film pixel of the crop. sums holds
-   3 doubles per crop pixel. Alpha is not used: pixels past the table's last face (which POV-Ray
+   duplicate, dropped) into the sums of the film pixels of the crop, develop_sums_per_pixel
+   doubles each. Alpha is not used: pixels past the table's last face (which POV-Ray
    leaves black) are recognised by their index. Chunk k's image must be exactly packed_width x
    (samplemap_chunk_rows + 1), else L2P_FAILED with a message naming the sizes; a record whose
    film pixel is outside the crop (possible only in a map made in memory) is L2P_FAILED too. */
@@ -15,7 +23,8 @@ int develop_accumulate(const samplemap *map, long long chunk, const float *rgba,
                        int height, double *sums, l2p_error *err);
 
 /* Turns sums into the picture: each crop pixel is its sum divided by spp (blocked samples
-   count as black: that is vignetting). rgb gets 3 floats a crop pixel. */
+   count as black: that is vignetting); with dispersion, the irradiance so found times the
+   radiance averaged with the band weights (develop.c says why). rgb gets 3 floats a crop pixel. */
 void develop_finish(const samplemap *map, const double *sums, float *rgb);
 
 /* develop_finish, then the picture written to out_path with the metadata below: only the

@@ -79,6 +79,11 @@ static inline double lens_semi_aperture_mm(const lens *l, int i)
    axis toward +y. */
 void lens_set_blades(lens *l, int count, double rotation_rad);
 
+/* How far the stop's opening reaches from the axis in the unit direction (ux, uy): its
+   semi-aperture when round; with blades, the distance to the polygon's edge that way,
+   apothem / max over the edges of (outward normal . u). */
+double lens_stop_reach_mm(const lens *l, double ux, double uy);
+
 /* The blades of surface i: the stop's when it has blades, else NULL (a round opening). */
 static inline const lens_blades *lens_blades_of(const lens *l, int i)
 {

@@ -105,3 +105,15 @@ void lens_set_blades(lens *l, int count, double rotation_rad)
         b->normal_y[k] = sin(angle);
     }
 }
+
+double lens_stop_reach_mm(const lens *l, double ux, double uy)
+{
+    const double a = lens_semi_aperture_mm(l, l->stop);
+    const lens_blades *b = &l->blades;
+    if (!b->count)
+        return a;
+    double far = -INFINITY;
+    for (int k = 0; k < b->count; k++)
+        far = fmax(far, b->normal_x[k] * ux + b->normal_y[k] * uy);
+    return a * b->apothem_ratio / far;
+}
