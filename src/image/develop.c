@@ -190,7 +190,10 @@ static int fill_attributes(const samplemap_header *h, metadata_text *t, image_at
         {"lens2pov:spp", t->spp},            {"Software", "lens2pov"},
     };
     memcpy(a, list, sizeof list);
-    return (int)(sizeof list / sizeof list[0]);
+    int n = (int)(sizeof list / sizeof list[0]);
+    if (h->wavelength_bands > 0)   /* only then: other pictures keep their bytes */
+        a[n++] = (image_attribute){"lens2pov:dispersion", "on"};
+    return n;
 }
 
 int develop_write_picture(const samplemap *map, const double *sums, const char *out_path,

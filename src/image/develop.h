@@ -38,6 +38,7 @@ int develop_write_picture(const samplemap *map, const double *sums, const char *
    picture is the crop only. Attributes (strings): lens2pov:lens, lens2pov:pupil,
    lens2pov:trace, lens2pov:weighting, FNumber, lens2pov:focus_distance (scene units, %.6g,
    "infinity"), lens2pov:film_distance_mm, lens2pov:film_diagonal_mm, lens2pov:spp,
+   lens2pov:dispersion = "on" (only with dispersion),
    Software = "lens2pov". Errors from a render name its file. */
 int develop_files(const samplemap *map, const char *const *renders, int render_count,
                   const char *out_path, l2p_error *err);

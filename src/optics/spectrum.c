@@ -2,6 +2,8 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
 
 /* exp(-(x - mu)^2 / (2 s^2)) with s = s_below for x < mu, s_above beyond. */
 static double lobe(double x, double mu, double s_below, double s_above)
@@ -40,10 +42,23 @@ void spectrum_linear_srgb(double nm, double rgb[3])
 enum { CELLS = 1600 };   /* a quarter nanometre */
 static double p_integral[CELLS + 1];          /* P, 0 .. 1 */
 static double rgb_integral[3][CELLS + 1];     /* of rgb_c, from SPECTRUM_MIN_NM */
-/* guide[j]: the last cell i with P(grid(i)) <= j / GUIDES, where the search for u starts. */
-enum { GUIDES = 1024 };
-static int guide[GUIDES + 1];
+/* P^-1 at u = j / INVERSES, interpolated linearly between: a sample's wavelength in a few
+   operations. It is within 0.07 nm of P^-1 for u in [0.001, 0.999]; in the first and last
+   thousandth, where the observer is nearly 0 and P^-1 steep, the draw is nearly uniform in
+   wavelength instead. The band weights are integrals between wavelengths found by this same
+   function, so they stay those of the density actually drawn. */
+enum { INVERSES = 4096 };
+static double inverse_nm[INVERSES + 1];
 static pthread_once_t tabulated = PTHREAD_ONCE_INIT;
+static atomic_bool ready;
+
+static void tabulate(void);
+
+static void need_tables(void)
+{
+    if (!atomic_load_explicit(&ready, memory_order_acquire))
+        pthread_once(&tabulated, tabulate);
+}
 
 static double grid_nm(int i)
 {
@@ -72,26 +87,27 @@ static void tabulate(void)
     for (int i = 1; i < CELLS; i++)
         p_integral[i] /= total;
     p_integral[CELLS] = 1.0;
-    for (int j = 0, i = 0; j <= GUIDES; j++) {
-        while (i < CELLS - 1 && p_integral[i + 1] <= (double)j / GUIDES)
+    for (int j = 0, i = 0; j <= INVERSES; j++) {
+        const double u = (double)j / INVERSES;
+        while (i < CELLS - 1 && p_integral[i + 1] <= u)
             i++;
-        guide[j] = i;
+        const double f = (u - p_integral[i]) / (p_integral[i + 1] - p_integral[i]);
+        inverse_nm[j] = grid_nm(i) + f * (grid_nm(i + 1) - grid_nm(i));
     }
+    inverse_nm[INVERSES] = SPECTRUM_MAX_NM;
+    atomic_store_explicit(&ready, true, memory_order_release);
 }
 
 double spectrum_wavelength_nm(double u)
 {
-    pthread_once(&tabulated, tabulate);
+    need_tables();
     if (!(u > 0.0))
         return SPECTRUM_MIN_NM;
     if (u >= 1.0)
         return SPECTRUM_MAX_NM;
-    int lo = guide[(int)(u * GUIDES)];   /* P(grid(lo)) <= u < P(grid(lo + 1)) */
-    while (lo < CELLS - 1 && p_integral[lo + 1] <= u)
-        lo++;
-    const int hi = lo + 1;
-    const double f = (u - p_integral[lo]) / (p_integral[hi] - p_integral[lo]);
-    return grid_nm(lo) + f * (grid_nm(hi) - grid_nm(lo));
+    const double x = u * INVERSES;
+    const int j = (int)x;
+    return inverse_nm[j] + (x - j) * (inverse_nm[j + 1] - inverse_nm[j]);
 }
 
 /* The integral of rgb_c from SPECTRUM_MIN_NM to nm, linear within a cell. */
@@ -105,7 +121,7 @@ static double rgb_integral_to(int c, double nm)
 
 void spectrum_band_weights(int band, int bands, double w[3])
 {
-    pthread_once(&tabulated, tabulate);
+    need_tables();
     const double lo = spectrum_wavelength_nm((double)band / bands);
     const double hi = spectrum_wavelength_nm((double)(band + 1) / bands);
     for (int c = 0; c < 3; c++)

@@ -20,8 +20,8 @@ void spectrum_cie1931_xyz(double wavelength_nm, double xyz[3]);
 void spectrum_linear_srgb(double wavelength_nm, double rgb[3]);
 
 /* The wavelength at u in [0, 1] of the sampling density p(lambda), proportional to
-   x + y + z over [SPECTRUM_MIN_NM, SPECTRUM_MAX_NM]: lambda = P^-1(u), P its integral.
-   Increasing; u = 0 and 1 give the ends exactly. */
+   x + y + z over [SPECTRUM_MIN_NM, SPECTRUM_MAX_NM]: lambda = P^-1(u), P its integral,
+   tabulated (spectrum.c says how closely). Increasing; u = 0 and 1 give the ends exactly. */
 double spectrum_wavelength_nm(double u);
 
 /* The colour weights of band k of `bands`, the bands being equal parts of u (so equal shares
