@@ -63,8 +63,11 @@ static const cli_option OPTIONS[] = {
      "                                this size [one include]\n"},
     {"--memory-mb", NULL, CMD_RENDER, false, false,
      "  --memory-mb MB                POV-Ray memory a process [1024]\n"},
-    {"--rays", NULL, CMD_SAMPLES, false, false,
+    {"--rays", NULL, CMD_TRACE, false, false,
      "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"},
+    {"--rays", NULL, CMD_RENDER, false, false,
+     "  --rays FILE.csv               every ray sent to POV-Ray; field sampling: every\n"
+     "                                rendered pixel's exact ray and its render pixel [none]\n"},
     {"--scene", NULL, CMD_TRACE, false, false,
      "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"},
     {"--sampling", NULL, CMD_RENDER, false, false,

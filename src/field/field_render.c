@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "field/fieldrays.h"
 #include "field/sobol.h"
 #include "field/subimage.h"
 #include "image/develop.h"
@@ -19,7 +20,7 @@ typedef struct sub {
     field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
     float *weights;            /* one a crop pixel, while building; then in its file */
     field_stats stats;
-    int render, dx, dy;        /* where it is rendered */
+    field_placement at;        /* where it is rendered */
 } sub;
 
 typedef struct render_plan {
@@ -169,7 +170,7 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_pl
         p->first = first, p->count = best_n, p->faces = 0;
         for (int i = 0; i < best_n; i++) {
             sub *s = &subs[first + i];
-            s->render = renders, s->dx = i % best_nx * w, s->dy = i / best_nx * h;
+            s->at = (field_placement){renders, i % best_nx * w, i / best_nx * h};
             p->faces += s->stats.faces;
         }
         first += best_n;
@@ -200,9 +201,11 @@ static int write_render(const camera *c, const sub *subs, const render_plan *p, 
     field_mesh m;
     field_mesh_init(&m, p->width, p->height);
     int st = L2P_OK;
-    for (int i = 0; i < p->count && !st; i++)
-        if (field_mesh_append(&m, &subs[p->first + i].mesh, subs[p->first + i].dx, subs[p->first + i].dy) < 0)
+    for (int i = 0; i < p->count && !st; i++) {
+        const sub *s = &subs[p->first + i];
+        if (field_mesh_append(&m, &s->mesh, s->at.dx, s->at.dy) < 0)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
     double world[12];
     world_matrix(c, world);
     FILE *f = st ? NULL : fopen(ch->include_path, "w");
@@ -224,6 +227,21 @@ static int write_render(const camera *c, const sub *subs, const render_plan *p, 
             st = l2p_fail(err, L2P_FAILED, ch->ini_path, 0, "cannot write");
     }
     return st;
+}
+
+/* --rays: written once the sub-images have their renders, before POV-Ray runs, so that a
+   disk too full for it fails the render at once; the caller renames it into place when the
+   render succeeds. */
+static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l2p_error *err)
+{
+    field_placement *at = malloc(sizeof *at * (size_t)spp);
+    if (!at)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < spp; k++)
+        at[k] = subs[k].at;
+    int st = field_rays_write(csv->fp, csv->final_path, c, at, spp, err);
+    free(at);
+    return st ? st : outfile_finish(csv, err);
 }
 
 /* ---------------------------------------------------------------- developing */
@@ -253,7 +271,7 @@ static int develop_render(const render_plan *p, const sub *subs, const char *exr
                 const float wt = weights[(size_t)y * w + x];
                 if (wt <= 0)
                     continue;   /* blocked: no face, black */
-                const float *px = rgba + 4 * ((size_t)(s->dy + y + 1) * iw + s->dx + x);
+                const float *px = rgba + 4 * ((size_t)(s->at.dy + y + 1) * iw + s->at.dx + x);
                 for (int ch = 0; ch < 3; ch++)
                     sums[3 * ((size_t)y * w + x) + ch] += (double)wt * px[ch];
             }
@@ -335,7 +353,10 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     if (!st) {
         const int jobs = o->jobs > 0 ? o->jobs : 1;
         int renders = pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
-        st = render_and_develop(c, o, subs, plans, renders, err);
+        if (o->rays_csv)
+            st = write_rays(c, subs, spp, o->rays_csv, err);
+        if (!st)
+            st = render_and_develop(c, o, subs, plans, renders, err);
     }
     for (int k = 0; k < spp; k++)
         field_mesh_free(&subs[k].mesh), free(subs[k].weights);
