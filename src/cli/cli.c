@@ -1,5 +1,6 @@
 #include "cli/cli.h"
 #include "cli/values.h"
+#include "field/field_render.h"
 
 #include <errno.h>
 #include <math.h>
@@ -355,7 +356,7 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
     memset(c, 0, sizeof *c);
     camera_options_default(&c->cam);
     c->angle_deg = NAN;
-    c->field_tolerance = 0.05;
+    c->field_tolerance = FIELD_DEFAULT_TOLERANCE_PX;
     const char *cmd_name = first > 0 ? argv[first - 1] : "";
     const unsigned command = command_bit(cmd_name);
     if (!command)

@@ -437,7 +437,7 @@ int render_command(const cli *given, l2p_error *err)
     if (!st && given->field_sampling && given->povray_args)
         st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "POV-Ray's options after -- (animations) need "
                       "--sampling pixel");
-    if (!st && !given->field_sampling)   /* its estimates are pixel sampling's */
+    if (!st)
         st = size_check_render(given, given->keep_temp ? given->keep_temp : temp_root(), jobs,
                                err);
     if (st)

@@ -20,6 +20,9 @@ typedef struct field_render_options {
                                   committed; NULL: none */
 } field_render_options;
 
+/* --field-tolerance's default, in pixels: no picture shows an error this small. */
+#define FIELD_DEFAULT_TOLERANCE_PX 0.05
+
 /* Faces a POV-Ray render holds at most (a sub-image with more gets a render of its own):
    POV-Ray's per-pixel face search grows with the faces in a UV grid cell. */
 enum { FIELD_FACES_PER_RENDER = 20000 };
