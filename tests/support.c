@@ -273,6 +273,69 @@ csv_ray *read_rays_csv(const char *path, size_t *count)
     return r;
 }
 
+/* One row of a field render's CSV: the pixel-sampling columns, then image, image_x, image_y. */
+field_csv_ray *read_field_rays_csv(const char *path, size_t *count)
+{
+    FILE *f = fopen(path, "r");
+    cr_assert_not_null(f, "cannot read %s", path);
+    char line[1024];
+    cr_assert_not_null(fgets(line, sizeof line, f));
+    cr_assert_str_eq(line, "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,"
+                           "dir_x,dir_y,dir_z,weight,image,image_x,image_y\n");
+    size_t n = 0, cap = 1024;
+    field_csv_ray *r = malloc(cap * sizeof *r);
+    while (fgets(line, sizeof line, f)) {
+        if (n == cap)
+            r = realloc(r, (cap *= 2) * sizeof *r);
+        field_csv_ray *x = &r[n++];
+        int k = sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d", &x->ray.raster_x,
+                       &x->ray.raster_y, &x->ray.film_x, &x->ray.film_y, &x->ray.o.x, &x->ray.o.y,
+                       &x->ray.o.z, &x->ray.d.x, &x->ray.d.y, &x->ray.d.z, &x->ray.weight, &x->image,
+                       &x->image_x, &x->image_y);
+        cr_assert_eq(k, 14, "bad csv row: %s", line);
+    }
+    fclose(f);
+    *count = n;
+    return r;
+}
+
+/* The numbers after `key {`: a count, then count groups of n numbers in <...>. */
+static double *read_block(const char *text, const char *key, int n, int *count)
+{
+    const char *p = strstr(text, key);
+    cr_assert_not_null(p, "no %s", key);
+    p = strchr(p, '{') + 1;
+    *count = (int)strtol(p, (char **)&p, 10);
+    double *v = malloc(sizeof *v * (size_t)(*count * n + 1));
+    for (int i = 0; i < *count * n; i++) {
+        while (*p && !(*p == '-' || *p == '.' || (*p >= '0' && *p <= '9')))
+            p++;
+        v[i] = strtod(p, (char **)&p);
+    }
+    return v;
+}
+
+void read_field_include(const char *text, povuv_mesh *pm)
+{
+    int nv, nn, nu, nf;
+    double *pos = read_block(text, "vertex_vectors", 3, &nv), *nrm = read_block(text, "normal_vectors", 3, &nn);
+    double *uv = read_block(text, "uv_vectors", 2, &nu), *tri = read_block(text, "face_indices", 3, &nf);
+    cr_assert(nv == nn && nv == nu);
+    povuv_face *faces = malloc(sizeof *faces * (size_t)(nf + 1));
+    for (int k = 0; k < nf; k++) {
+        double p[3][3], n[3][3], t[3][2];
+        for (int j = 0; j < 3; j++) {
+            int i = (int)tri[3 * k + j];
+            cr_assert(i >= 0 && i < nv);
+            memcpy(p[j], pos + 3 * i, sizeof p[j]), memcpy(n[j], nrm + 3 * i, sizeof n[j]);
+            memcpy(t[j], uv + 2 * i, sizeof t[j]);
+        }
+        povuv_face_init(&faces[k], p, n, t);
+    }
+    cr_assert_eq(povuv_mesh_init(pm, faces, nf), 0);
+    free(pos), free(nrm), free(uv), free(tri);
+}
+
 /* Parses just what the emitter writes: "vertex_vectors { N," then "<x,y,z>," per vertex,
    "face_indices { M," then "<a,b,c>," per face, then "scale S translate <x, y, z>". */
 pov_ray *read_include_as_povray(const char *path, size_t *count)

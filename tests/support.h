@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include "base/vec3.h"
 #include "camera/camera.h"
+#include "field/povuv.h"
 
 #ifndef LENS2POV_SOURCE_DIR
 #define LENS2POV_SOURCE_DIR "."
@@ -52,6 +53,17 @@ typedef struct csv_ray {
     double weight;
 } csv_ray;
 csv_ray *read_rays_csv(const char *path, size_t *count);
+
+/* One row of a field render's --rays CSV: the columns above, then where it is rendered. */
+typedef struct field_csv_ray {
+    csv_ray ray;
+    int image, image_x, image_y;
+} field_csv_ray;
+field_csv_ray *read_field_rays_csv(const char *path, size_t *count);
+
+/* A distribution-3 include (vertex_vectors, normal_vectors, uv_vectors, face_indices) as
+   POV-Ray reads it, through the model of src/field/povuv.c; fails the test when it cannot. */
+void read_field_include(const char *text, povuv_mesh *pm);
 
 /* The rays an include gives POV-Ray: vertices as float32, origin = centroid, direction =
    normalize((P3-P1) x (P2-P1)), then the scale and translate, world space in scene units. */

@@ -69,44 +69,6 @@ Test(field, seeds_scramble_the_samples)
 #include <stdio.h>
 #include "field/subimage.h"
 
-/* The numbers after `key {`: a count, then count groups of n numbers in <...>. */
-static double *read_block(const char *text, const char *key, int n, int *count)
-{
-    const char *p = strstr(text, key);
-    cr_assert_not_null(p, "no %s", key);
-    p = strchr(p, '{') + 1;
-    *count = (int)strtol(p, (char **)&p, 10);
-    double *v = malloc(sizeof *v * (size_t)(*count * n + 1));
-    for (int i = 0; i < *count * n; i++) {
-        while (*p && !(*p == '-' || *p == '.' || (*p >= '0' && *p <= '9')))
-            p++;
-        v[i] = strtod(p, (char **)&p);
-    }
-    return v;
-}
-
-/* The include as POV-Ray reads it, through the model. */
-static void read_include(const char *text, povuv_mesh *pm)
-{
-    int nv, nn, nu, nf;
-    double *pos = read_block(text, "vertex_vectors", 3, &nv), *nrm = read_block(text, "normal_vectors", 3, &nn);
-    double *uv = read_block(text, "uv_vectors", 2, &nu), *tri = read_block(text, "face_indices", 3, &nf);
-    cr_assert(nv == nn && nv == nu);
-    povuv_face *faces = malloc(sizeof *faces * (size_t)(nf + 1));
-    for (int k = 0; k < nf; k++) {
-        double p[3][3], n[3][3], t[3][2];
-        for (int j = 0; j < 3; j++) {
-            int i = (int)tri[3 * k + j];
-            cr_assert(i >= 0 && i < nv);
-            memcpy(p[j], pos + 3 * i, sizeof p[j]), memcpy(n[j], nrm + 3 * i, sizeof n[j]);
-            memcpy(t[j], uv + 2 * i, sizeof t[j]);
-        }
-        povuv_face_init(&faces[k], p, n, t);
-    }
-    cr_assert_eq(povuv_mesh_init(pm, faces, nf), 0);
-    free(pos), free(nrm), free(uv), free(tri);
-}
-
 /* Builds the sub-image of shared sample k, writes its include, reads it back through the
    model, and checks every pixel of the crop against its exact traced ray. */
 static void check_subimage(const char *lens, camera_options *o, double tol, uint32_t k, field_stats *st)
@@ -128,7 +90,7 @@ static void check_subimage(const char *lens, camera_options *o, double tol, uint
     cr_assert_eq(field_mesh_write_include(f, &m, "Field_Test", world), 0);
     fclose(f);
     povuv_mesh pm;
-    read_include(text, &pm);
+    read_field_include(text, &pm);
     const double front = c.lens.surface[0].vertex_z_mm;
     long rendered = 0, passed = 0;
     double worst = 0;
@@ -242,7 +204,7 @@ Test(field, sub_images_moved_into_a_render_keep_their_rays)
     cr_assert_eq(field_mesh_write_include(f, &render, "Field_Test", world), 0);
     fclose(f);
     povuv_mesh pm;
-    read_include(text, &pm);
+    read_field_include(text, &pm);
     const double front = c.lens.surface[0].vertex_z_mm;
     for (int y = 0; y < rh; y++)
         for (int x = 0; x < rw; x++) {

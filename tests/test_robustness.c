@@ -870,8 +870,9 @@ static double seconds_since(const struct timespec *t0)
     return (double)(t1.tv_sec - t0->tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0->tv_nsec);
 }
 
-/* A request no disk holds (4e11 rays: tens of terabytes) is refused from its estimate in well
-   under a second, naming it, with nothing written; the same options on a small film work. */
+/* A request no disk holds (4e11 rays: tens of terabytes; with field sampling, terabytes of
+   renders and weights) is refused from its estimate in well under a second, naming it, with
+   nothing written; the same options on a small film work. */
 Test(robustness, requests_that_cannot_fit_are_refused_before_tracing)
 {
     const char *dir = test_tmpdir();
@@ -892,6 +893,10 @@ Test(robustness, requests_that_cannot_fit_are_refused_before_tracing)
           png, "--keep-temp", keep}},
         {{"render", scene, DGAUSS, "--width", "320", "--height", "240", "--spp", "100000", "-o",
           png}},
+        {{"render", scene, DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o",
+          png, "--sampling", "field"}},
+        {{"render", scene, DGAUSS, huge[0], huge[1], huge[2], huge[3], huge[4], huge[5], "-o",
+          png, "--sampling", "field", "--rays", csv}},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         const char *const *a = cases[i].args;

@@ -1,5 +1,6 @@
 #include "cli/cli.h"
 #include "cli/values.h"
+#include "field/field_render.h"
 
 #include <errno.h>
 #include <math.h>
@@ -66,8 +67,11 @@ static const cli_option OPTIONS[] = {
      "                                this size [one include]\n"},
     {"--memory-mb", NULL, CMD_RENDER, false, false,
      "  --memory-mb MB                POV-Ray memory a process [1024]\n"},
-    {"--rays", NULL, CMD_SAMPLES, false, false,
+    {"--rays", NULL, CMD_TRACE, false, false,
      "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"},
+    {"--rays", NULL, CMD_RENDER, false, false,
+     "  --rays FILE.csv               every ray sent to POV-Ray; field sampling: every\n"
+     "                                rendered pixel's exact ray and its render pixel [none]\n"},
     {"--scene", NULL, CMD_TRACE, false, false,
      "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"},
     {"--sampling", NULL, CMD_RENDER, false, false,
@@ -371,7 +375,7 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
     memset(c, 0, sizeof *c);
     camera_options_default(&c->cam);
     c->angle_deg = NAN;
-    c->field_tolerance = 0.05;
+    c->field_tolerance = FIELD_DEFAULT_TOLERANCE_PX;
     const char *cmd_name = first > 0 ? argv[first - 1] : "";
     const unsigned command = command_bit(cmd_name);
     if (!command)

@@ -381,13 +381,15 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     return st;
 }
 
-/* --sampling field: src/field/field_render.c does the rest. */
+/* --sampling field: src/field/field_render.c does the rest, --rays included, which is
+   renamed into place once the picture is. */
 static int field_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
-                            l2p_error *err)
+                            outfile *csv, l2p_error *err)
 {
     const field_render_options fo = {c->positional[0], ws->dir, c->output, jobs, cores_online(),
-                                     !c->quiet, c->field_tolerance};
-    return field_render(cam, &fo, err);
+                                     !c->quiet, c->field_tolerance, c->rays_csv ? csv : NULL};
+    const int st = field_render(cam, &fo, err);
+    return !st && c->rays_csv ? outfile_commit(csv, err) : st;
 }
 
 /* Table t: its camera, then its frames. */
@@ -409,7 +411,7 @@ static int render_table(const render_frames *rf, int t, const workspace *ws, int
         if (!(st = framing_camera_setup(&cam, &l, c, err))) {
             if (t == 0)
                 cli_warn(c, &cam);
-            st = c->field_sampling ? field_and_render(c, &cam, ws, jobs, err)
+            st = c->field_sampling ? field_and_render(c, &cam, ws, jobs, csv, err)
                                    : trace_and_render(c, &cam, ws, jobs, csv, &tf, t, err);
         }
         camera_free(&cam);   /* also after a failed setup, as it always was */
@@ -432,12 +434,10 @@ int render_command(const cli *given, l2p_error *err)
 {
     const int jobs = given->jobs > 0 ? given->jobs : cores_online();
     int st = check_inputs(given, err);
-    if (!st && given->field_sampling && given->rays_csv)
-        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--rays needs --sampling pixel");
     if (!st && given->field_sampling && given->povray_args)
         st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "POV-Ray's options after -- (animations) need "
                       "--sampling pixel");
-    if (!st && !given->field_sampling)   /* its estimates are pixel sampling's */
+    if (!st)
         st = size_check_render(given, given->keep_temp ? given->keep_temp : temp_root(), jobs,
                                err);
     if (st)

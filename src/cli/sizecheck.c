@@ -7,6 +7,8 @@
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <sys/sysinfo.h>
+#include "field/field_render.h"
+#include "field/subimage.h"
 #include "raytable/raytable.h"
 
 /* What a POV-Ray process takes with an empty scene, and what developing keeps a film pixel in
@@ -14,39 +16,138 @@
 #define POVRAY_BASE_BYTES (16.0 * 1048576.0)
 #define DEVELOP_BYTES_PER_PIXEL 32.0
 
+static void crop_size(const camera_options *o, int *w, int *h)
+{
+    *w = o->crop_x1 ? o->crop_x1 - o->crop_x0 : o->width;
+    *h = o->crop_y1 ? o->crop_y1 - o->crop_y0 : o->height;
+}
+
 static double crop_pixels(const camera_options *o)
 {
-    const double w = o->crop_x1 ? o->crop_x1 - o->crop_x0 : o->width;
-    const double h = o->crop_y1 ? o->crop_y1 - o->crop_y0 : o->height;
-    return w * h;
+    int w, h;
+    crop_size(o, &w, &h);
+    return (double)w * h;
 }
 
 /* POV-Ray's processes at once, their chunks cut as render cuts them (chunk_faces_for), or
    developing after them, whichever takes more. */
-static double render_memory(const cli *c, double faces, double pixels, int jobs)
+static void render_memory(const cli *c, double faces, double pixels, int jobs, size_estimate *e)
 {
     const double budget = (double)raytable_faces_for_memory(c->memory_mb);
     const double chunks = jobs * ceil(ceil(faces / budget) / jobs);
     const double chunk_faces = faces / chunks;
     const double at_once = chunks < jobs ? chunks : jobs;
-    const double povray = at_once * (chunk_faces * RAYTABLE_POVRAY_BYTES_PER_FACE + POVRAY_BASE_BYTES);
+    e->povray_process_bytes = chunk_faces * RAYTABLE_POVRAY_BYTES_PER_FACE + POVRAY_BASE_BYTES;
+    const double povray = at_once * e->povray_process_bytes;
     const double develop = faces * SIZE_MAP_BYTES_PER_FACE + chunk_faces * 16.0 +
                            pixels * DEVELOP_BYTES_PER_PIXEL;
-    return povray > develop ? povray : develop;
+    e->memory_bytes = povray > develop ? povray : develop;
 }
 
-size_estimate size_estimate_of(const cli *c, int jobs)
+static size_estimate pixel_estimate(const cli *c, int jobs)
 {
     const double pixels = crop_pixels(&c->cam);
     const double faces = pixels * c->cam.spp;
-    size_estimate e = {.faces = faces};
+    size_estimate e = {.faces = faces, .csv_in_workspace = jobs > 0};
     e.table_bytes = faces * (SIZE_INCLUDE_BYTES_PER_FACE + SIZE_MAP_BYTES_PER_FACE) + 8192.0;
     e.csv_bytes = c->rays_csv ? faces * SIZE_CSV_BYTES_PER_FACE : 0.0;
     if (jobs > 0) {
         e.renders_bytes = faces * SIZE_EXR_BYTES_PER_FACE;
-        e.memory_bytes = render_memory(c, faces, pixels, jobs);
+        render_memory(c, faces, pixels, jobs, &e);
     }
     return e;
+}
+
+/* ---------------------------------------------------------------- field sampling */
+
+/* How field_render will lay out the work, from the options: estimates of the faces, and
+   bounds of what a render holds whatever the faces turn out to be. */
+typedef struct field_layout {
+    double pixels, spp;
+    double subimage_faces;     /* a sub-image's faces, estimated */
+    double subimage_pixels;    /* a sub-image's render, had it one of its own */
+    double render_faces;       /* a render's faces, at most */
+    double render_pixels;      /* a render's picture, at most */
+    double at_once;            /* POV-Ray processes at once, at most */
+} field_layout;
+
+/* A sub-image's faces. Where the lens passes the rays, the error between vertices h pixels
+   apart goes as h^2 / n on a crop n pixels wide (the field's curvature in pixels falls as 1 /
+   n), so the spacing the tolerance allows goes as sqrt(n tol) and the faces as n / tol; where
+   it blocks some, faces follow the region's edge down to single pixels, also as n. Hence
+   faces proportional to width plus height, and to 1 / tolerance below the default (the edges
+   stay as fine above it), plus the coarsest grid's; a sub-image with more faces than pixels
+   is refused. */
+static double field_subimage_faces(const cli *c, int w, int h, double coarsest)
+{
+    const double finer = fmax(1.0, FIELD_DEFAULT_TOLERANCE_PX / c->field_tolerance);
+    const double faces = SIZE_FIELD_FACES_PER_SIDE_PIXEL * (w + h) * finer + coarsest;
+    return fmax(1.0, fmin(faces, (double)w * h));
+}
+
+/* field_render packs consecutive sub-images into a render up to FIELD_FACES_PER_RENDER faces
+   and at most spp / jobs (rounded up), at least one; no sub-image whose pixels all pass has
+   fewer faces than the coarsest grid's two a cell, which bounds how many share a render. Its
+   picture, 2^a x 2^b as POV-Ray renders it, is chosen to waste the fewest pixels a sub-image,
+   one sub-image alone among the choices: so it has at most its sub-images' own renders'
+   pixels. */
+static field_layout field_layout_of(const cli *c, int jobs)
+{
+    int w, h;
+    crop_size(&c->cam, &w, &h);
+    field_layout l = {.pixels = (double)w * h, .spp = c->cam.spp};
+    const double cells = ceil((w - 1.0) / FIELD_BASE_CELL) * ceil((h - 1.0) / FIELD_BASE_CELL);
+    const double coarsest = fmax(1.0, 2.0 * cells);
+    const double most = ceil(l.spp / (jobs > 0 ? jobs : 1));
+    l.subimage_faces = field_subimage_faces(c, w, h, coarsest);
+    l.subimage_pixels = (field_render_size(w) + 1.0) * (field_render_size(h) + 1.0);
+    const double fit = fmax(1.0, floor(FIELD_FACES_PER_RENDER / coarsest));
+    l.render_faces = fmin(most * l.subimage_faces, fmax(FIELD_FACES_PER_RENDER, l.subimage_faces));
+    l.render_pixels = fmin(most, fit) * l.subimage_pixels;
+    l.at_once = fmin(jobs > 0 ? jobs : 1, l.spp);
+    return l;
+}
+
+/* lens2pov keeps every sub-image's mesh until the renders are written: a face (field_mesh's
+   tri) and a vertex (pos, nrm, pix, uv) a face, as a triangulated grid has half as many
+   vertices as faces and arrays grown by doubling hold up to twice what they use. Meanwhile it
+   builds on jobs threads (a crop pixel's ray, weight, flags, prefix sum and vertex index,
+   subimage.c), waits for POV-Ray's processes, then develops (the sums, a sub-image's
+   weights, a render's picture as float RGBA). */
+static void field_memory(const field_layout *l, int jobs, size_estimate *e)
+{
+    const double mesh_face = 3 * sizeof(int) + 6 * sizeof(float) + 4 * sizeof(double);
+    const double meshes = l->spp * l->subimage_faces * mesh_face;
+    const double build = jobs * l->pixels * (sizeof(ray) + sizeof(float) + 2 + 2 * sizeof(int));
+    e->povray_process_bytes = POVRAY_BASE_BYTES +
+                              l->render_faces * SIZE_FIELD_POVRAY_BYTES_PER_FACE +
+                              l->render_pixels * SIZE_POVRAY_BYTES_PER_PIXEL;
+    const double povray = l->at_once * e->povray_process_bytes;
+    const double develop = l->pixels * (DEVELOP_BYTES_PER_PIXEL + sizeof(float)) +
+                           l->render_pixels * 4 * sizeof(float);
+    e->memory_bytes = meshes + fmax(build, fmax(povray, develop));
+}
+
+/* The workspace holds each render's include and ini (and POV-Ray's wrapper scene and log: at
+   most a render a sub-image), each sub-image's weights (a float a crop pixel) and each
+   render's EXR; --rays goes straight to its own folder. */
+static size_estimate field_estimate(const cli *c, int jobs)
+{
+    const field_layout l = field_layout_of(c, jobs);
+    size_estimate e = {.faces = l.spp * l.subimage_faces};
+    e.table_bytes = e.faces * SIZE_FIELD_INCLUDE_BYTES_PER_FACE +
+                    l.spp * (SIZE_FIELD_RENDER_FILES_BYTES + l.pixels * sizeof(float));
+    e.csv_bytes = c->rays_csv ? l.spp * l.pixels * SIZE_FIELD_CSV_BYTES_PER_ROW : 0.0;
+    if (jobs > 0) {
+        e.renders_bytes = l.spp * l.subimage_pixels * SIZE_EXR_BYTES_PER_FACE;
+        field_memory(&l, jobs, &e);
+    }
+    return e;
+}
+
+size_estimate size_estimate_of(const cli *c, int jobs)
+{
+    return c->field_sampling ? field_estimate(c, jobs) : pixel_estimate(c, jobs);
 }
 
 /* "845 GB", "12.3 MB". */
@@ -161,8 +262,9 @@ int size_check_render(const cli *c, const char *work_dir, int jobs, l2p_error *e
     if (c->no_size_check)
         return L2P_OK;
     const size_estimate e = size_estimate_of(c, jobs);
-    /* The CSV is written in the workspace, then moved (or copied) to --rays. */
-    const disk_need needs[] = {{work_dir, true, e.table_bytes + e.renders_bytes + e.csv_bytes},
+    /* Pixel sampling writes the CSV in the workspace, then moves (or copies) it to --rays. */
+    const double csv_work = e.csv_in_workspace ? e.csv_bytes : 0.0;
+    const disk_need needs[] = {{work_dir, true, e.table_bytes + e.renders_bytes + csv_work},
                                {c->rays_csv ? c->rays_csv : c->output, false, e.csv_bytes},
                                {c->output, false, crop_pixels(&c->cam) * 16.0}};
     int st = check_disk(c, needs, 3, err);

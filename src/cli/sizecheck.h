@@ -1,7 +1,10 @@
 /* Estimates, before any tracing, of the disk and memory a trace or render will take, from the
    options alone, and the refusal of a request that cannot fit (--no-size-check lets it
-   through). Every sample of the crop is counted as a face: an upper bound, since the lens
-   blocks some. */
+   through). With pixel sampling every sample of the crop is counted as a face: an upper
+   bound, since the lens blocks some. With field sampling POV-Ray gets far fewer faces than
+   samples, estimated from the crop's sides and the tolerance, and each render's picture is
+   its own size (docs/fields.md, "Memory and disk"); every pixel of every sub-image is counted
+   as rendered. */
 #ifndef LENS2POV_SIZECHECK_H
 #define LENS2POV_SIZECHECK_H
 
@@ -15,15 +18,32 @@
 #define SIZE_CSV_BYTES_PER_FACE 230.0
 #define SIZE_EXR_BYTES_PER_FACE 8.0
 
+/* Field sampling, from real renders of the four lenses (rounded up; docs/fields.md): a
+   sub-image's faces at the default tolerance for each pixel of the crop's width plus height,
+   with a margin over the densest lens; a face in a distribution-3 include (its share of the
+   vertices, normals and UVs with it); a render's ini, wrapper scene and POV-Ray log; a CSV
+   row, which adds the render pixel's three integers to a pixel-sampling row; and POV-Ray
+   3.7.0.10's memory for a face of a distribution-3 camera mesh and for a pixel of its
+   picture (docs/povray.md). */
+#define SIZE_FIELD_FACES_PER_SIDE_PIXEL 20.0
+#define SIZE_FIELD_INCLUDE_BYTES_PER_FACE 100.0
+#define SIZE_FIELD_RENDER_FILES_BYTES 65536.0
+#define SIZE_FIELD_CSV_BYTES_PER_ROW (SIZE_CSV_BYTES_PER_FACE + 20.0)
+#define SIZE_FIELD_POVRAY_BYTES_PER_FACE 200.0
+#define SIZE_POVRAY_BYTES_PER_PIXEL 40.0
+
 typedef struct size_estimate {
-    double faces;                 /* at most */
-    double table_bytes;           /* include, ini and sample map */
+    double faces;                 /* at most (field sampling: estimated) */
+    double table_bytes;           /* include, ini and sample map; field: includes, inis, weights */
     double csv_bytes;             /* --rays, 0 without */
-    double renders_bytes;         /* render: the chunks' EXR files */
-    double memory_bytes;          /* render: POV-Ray's processes at once, or developing */
+    double renders_bytes;         /* render: the chunks' (field: the renders') EXR files */
+    double memory_bytes;          /* render: POV-Ray's processes at once, or lens2pov's own work */
+    double povray_process_bytes;  /* render: one POV-Ray process, at most */
+    bool csv_in_workspace;        /* the CSV is written in the workspace, then moved to --rays */
 } size_estimate;
 
-/* The estimate for the options of c; jobs: POV-Ray processes at once (render), 0 for trace. */
+/* The estimate for the options of c (pixel or field sampling, c->field_sampling); jobs:
+   POV-Ray processes at once (render), 0 for trace. */
 size_estimate size_estimate_of(const cli *c, int jobs);
 
 /* trace: the table in -o's folder and the CSV in its own fit on their file systems. */

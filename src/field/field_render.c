@@ -7,12 +7,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "field/sobol.h"
+#include "field/fieldrays.h"
 #include "field/subimage.h"
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "optics/pupil.h"
-#include "optics/spectrum.h"
 #include "povray/povray.h"
 #include "raytable/povmesh.h"
 
@@ -21,7 +20,7 @@ typedef struct sub {
     float *weights;            /* one a crop pixel, while building; then in its file */
     double colour[3];          /* its wavelength band's colour weights, with dispersion */
     field_stats stats;
-    int render, dx, dy;        /* where it is rendered */
+    field_placement at;        /* where it is rendered */
 } sub;
 
 typedef struct render_plan {
@@ -80,20 +79,6 @@ static int load_weights(const char *dir, int k, float *weights, size_t n, l2p_er
     return st;
 }
 
-/* Sub-image k's shared sample; with dispersion also its wavelength, the bands dealt out to
-   the sub-images as pixel sampling deals them to a pixel's samples, and the band's colour. */
-static film_sample shared_sample(const camera *c, int k, double colour[3])
-{
-    film_sample s = sobol_shared_sample(c->samples.seed, (uint32_t)k);
-    if (c->dispersion) {
-        const wavelength_sample w = sample_pattern_wavelength(&c->samples,
-                                                              sample_pattern_shared(&c->samples), k);
-        s.wavelength_nm = w.nm;
-        spectrum_band_weights(w.band, c->samples.spp, colour);
-    }
-    return s;
-}
-
 static void *build_worker(void *arg)
 {
     job *j = arg;
@@ -102,7 +87,7 @@ static void *build_worker(void *arg)
         sub *s = &j->subs[k];
         l2p_error e;
         s->weights = malloc(pixels * sizeof *s->weights);
-        const film_sample shared = shared_sample(j->c, k, s->colour);
+        const film_sample shared = field_shared_sample(j->c, k, s->colour);
         int st = s->weights ? field_build_subimage(j->c, shared, j->tol, FIELD_BASE_CELL, &s->mesh,
                                                    s->weights, &s->stats, &e)
                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
@@ -186,7 +171,7 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_pl
         p->first = first, p->count = best_n, p->faces = 0;
         for (int i = 0; i < best_n; i++) {
             sub *s = &subs[first + i];
-            s->render = renders, s->dx = i % best_nx * w, s->dy = i / best_nx * h;
+            s->at = (field_placement){renders, i % best_nx * w, i / best_nx * h};
             p->faces += s->stats.faces;
         }
         first += best_n;
@@ -217,9 +202,11 @@ static int write_render(const camera *c, const sub *subs, const render_plan *p, 
     field_mesh m;
     field_mesh_init(&m, p->width, p->height);
     int st = L2P_OK;
-    for (int i = 0; i < p->count && !st; i++)
-        if (field_mesh_append(&m, &subs[p->first + i].mesh, subs[p->first + i].dx, subs[p->first + i].dy) < 0)
+    for (int i = 0; i < p->count && !st; i++) {
+        const sub *s = &subs[p->first + i];
+        if (field_mesh_append(&m, &s->mesh, s->at.dx, s->at.dy) < 0)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
     double world[12];
     world_matrix(c, world);
     FILE *f = st ? NULL : fopen(ch->include_path, "w");
@@ -241,6 +228,21 @@ static int write_render(const camera *c, const sub *subs, const render_plan *p, 
             st = l2p_fail(err, L2P_FAILED, ch->ini_path, 0, "cannot write");
     }
     return st;
+}
+
+/* --rays: written once the sub-images have their renders, before POV-Ray runs, so that a
+   disk too full for it fails the render at once; the caller renames it into place when the
+   render succeeds. */
+static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l2p_error *err)
+{
+    field_placement *at = malloc(sizeof *at * (size_t)spp);
+    if (!at)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < spp; k++)
+        at[k] = subs[k].at;
+    int st = field_rays_write(csv->fp, csv->final_path, c, at, spp, err);
+    free(at);
+    return st ? st : outfile_finish(csv, err);
 }
 
 /* ---------------------------------------------------------------- developing */
@@ -270,7 +272,7 @@ static int develop_render(const render_plan *p, const sub *subs, const char *exr
                 const float wt = weights[(size_t)y * w + x];
                 if (wt <= 0)
                     continue;   /* blocked: no face, black */
-                const float *px = rgba + 4 * ((size_t)(s->dy + y + 1) * iw + s->dx + x);
+                const float *px = rgba + 4 * ((size_t)(s->at.dy + y + 1) * iw + s->at.dx + x);
                 develop_add(sums + stride * ((size_t)y * w + x), stride > 3 ? s->colour : NULL,
                             (double)wt, px);
             }
@@ -352,7 +354,10 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     if (!st) {
         const int jobs = o->jobs > 0 ? o->jobs : 1;
         int renders = pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
-        st = render_and_develop(c, o, subs, plans, renders, err);
+        if (o->rays_csv)
+            st = write_rays(c, subs, spp, o->rays_csv, err);
+        if (!st)
+            st = render_and_develop(c, o, subs, plans, renders, err);
     }
     for (int k = 0; k < spp; k++)
         field_mesh_free(&subs[k].mesh), free(subs[k].weights);

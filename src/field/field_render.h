@@ -5,6 +5,7 @@
 #define LENS2POV_FIELD_FIELD_RENDER_H
 
 #include <stdbool.h>
+#include "base/outfile.h"
 #include "camera/camera.h"
 
 typedef struct field_render_options {
@@ -15,7 +16,12 @@ typedef struct field_render_options {
     int threads_per_job;       /* +WTn; 0: POV-Ray's default */
     bool progress;
     double tolerance_px;       /* --field-tolerance */
+    outfile *rays_csv;         /* --rays: opened by the caller, written and finished here, not
+                                  committed; NULL: none */
 } field_render_options;
+
+/* --field-tolerance's default, in pixels: no picture shows an error this small. */
+#define FIELD_DEFAULT_TOLERANCE_PX 0.05
 
 /* Faces a POV-Ray render holds at most (a sub-image with more gets a render of its own):
    POV-Ray's per-pixel face search grows with the faces in a UV grid cell. */
@@ -23,7 +29,7 @@ enum { FIELD_FACES_PER_RENDER = 20000 };
 
 /* Builds, writes, renders and develops. L2P_BAD_INPUT naming --sampling pixel when the
    tolerance is not above 0 or a sub-image would need more faces than pixels; POV-Ray's errors
-   as povray_render_chunks gives them. */
+   as povray_render_chunks gives them. With rays_csv, the caller commits it on success. */
 int field_render(const camera *c, const field_render_options *o, l2p_error *err);
 
 #endif

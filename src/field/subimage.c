@@ -7,6 +7,8 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include "field/sobol.h"
+#include "optics/spectrum.h"
 
 void field_tolerance_of(const camera *c, double pixels, field_tolerance *t)
 {
@@ -43,6 +45,46 @@ typedef struct builder {
 
 /* ---------------------------------------------------------------- tracing */
 
+void field_pixel_raster(const camera *c, film_sample s, long i, double *rx, double *ry)
+{
+    const int w = c->crop_x1 - c->crop_x0;
+    *rx = c->crop_x0 + i % w + s.offset_x;
+    *ry = c->crop_y0 + i / w + s.offset_y;
+}
+
+film_sample field_shared_sample(const camera *c, int k, double colour[3])
+{
+    film_sample s = sobol_shared_sample(c->samples.seed, (uint32_t)k);
+    if (c->dispersion) {
+        const wavelength_sample w = sample_pattern_wavelength(&c->samples,
+                                                              sample_pattern_shared(&c->samples), k);
+        s.wavelength_nm = w.nm;
+        if (colour)
+            spectrum_band_weights(w.band, c->samples.spp, colour);
+    }
+    return s;
+}
+
+void field_trace_pixels(const camera *c, film_sample s, long first, int n, sample_batch *batch)
+{
+    batch->n = n;
+    for (int k = 0; k < n; k++) {
+        double rx, ry;
+        field_pixel_raster(c, s, first + k, &rx, &ry);
+        batch->film_point[k] = film_camera_from_raster(&c->film, rx, ry);
+        batch->u[k] = s.pupil_u;
+        batch->v[k] = s.pupil_v;
+        batch->wavelength_nm[k] = s.wavelength_nm;
+    }
+    camera_trace_batch(c, batch);
+    for (int k = 0; k < n; k++) {
+        const ray *r = &batch->out[k];
+        /* as with pixel sampling, a film point beyond the lens's reach is no sample */
+        batch->passed[k] = batch->passed[k] && pupil_reaches(&c->pupil, batch->film_point[k]) &&
+                           v3_isfinite(r->o) && v3_isfinite(r->d) && isfinite(batch->weight[k]);
+    }
+}
+
 static void trace_all(builder *b, film_sample s)
 {
     const camera *c = b->c;
@@ -54,29 +96,15 @@ static void trace_all(builder *b, film_sample s)
     const double front = c->lens.surface[0].vertex_z_mm;
     const long n = (long)b->w * b->h;
     for (long start = 0; start < n; start += CAMERA_BATCH) {
-        batch->n = (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH);
-        for (int k = 0; k < batch->n; k++) {
-            long i = start + k;
-            double rx = c->crop_x0 + i % b->w + s.offset_x, ry = c->crop_y0 + i / b->w + s.offset_y;
-            batch->film_point[k] = film_camera_from_raster(&c->film, rx, ry);
-            batch->u[k] = s.pupil_u;
-            batch->v[k] = s.pupil_v;
-            batch->wavelength_nm[k] = s.wavelength_nm;
-        }
-        camera_trace_batch(c, batch);
+        field_trace_pixels(c, s, start, (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH), batch);
         for (int k = 0; k < batch->n; k++) {
             ray r = batch->out[k];
-            long i = start + k;
-            vec3 fp = film_camera_from_raster(&c->film, c->crop_x0 + i % b->w + s.offset_x,
-                                              c->crop_y0 + i / b->w + s.offset_y);
-            /* as with pixel sampling, a film point beyond the lens's reach is no sample */
-            bool ok = batch->passed[k] && pupil_reaches(&c->pupil, fp) && v3_isfinite(r.o) &&
-                      v3_isfinite(r.d) && isfinite(batch->weight[k]);
+            const long i = start + k;
             r.o.z -= front;
             b->rays[i] = r;
-            b->passed[i] = ok;
+            b->passed[i] = batch->passed[k];
             if (b->weights)
-                b->weights[i] = ok ? (float)batch->weight[k] : 0.0f;
+                b->weights[i] = batch->passed[k] ? (float)batch->weight[k] : 0.0f;
         }
     }
     free(batch);

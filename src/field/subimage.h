@@ -39,6 +39,23 @@ enum { FIELD_BASE_CELL = 32 };   /* pixels between the vertices of the coarsest 
 int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
                          field_mesh *out, float *weights, field_stats *st, l2p_error *err);
 
+/* Pixel i of the crop (row by row: i = y * crop width + x) seen with shared sample s: its
+   raster position, (crop_x0 + x + offset_x, crop_y0 + y + offset_y). */
+void field_pixel_raster(const camera *c, film_sample s, long i, double *rx, double *ry);
+
+/* The exact rays of crop pixels first .. first + n - 1 (n <= CAMERA_BATCH) seen with shared
+   sample s, into b: each one's film point, ray (camera space), weight, and whether it is
+   rendered: the lens passes it, its film point is within the lens's reach (as pixel sampling
+   asks) and the ray and weight are finite. Building a sub-image and the --rays CSV both take
+   the rays from here, so that they are the same rays. */
+void field_trace_pixels(const camera *c, film_sample s, long first, int n, sample_batch *b);
+
+/* Sub-image k's shared sample: point k of the Owen-scrambled Sobol set; with dispersion also
+   its wavelength, the bands dealt to the sub-images as pixel sampling deals them to a pixel's
+   samples (sample_pattern_wavelength), and colour gets its band's colour weights (left as
+   they are without dispersion; may be NULL). */
+film_sample field_shared_sample(const camera *c, int k, double colour[3]);
+
 /* The render size for a crop of w x h: the smallest 2^a - 1 >= w, 2^b - 1 >= h, so that UVs
    are short binary fractions. */
 int field_render_size(int n);

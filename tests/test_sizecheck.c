@@ -1,0 +1,147 @@
+/* The up-front size estimate of a field render (src/cli/sizecheck.c) against what a real one
+   writes and what POV-Ray takes to render it, and the sizes of its renders. */
+#include <criterion/criterion.h>
+#include <dirent.h>
+#include <math.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include "cli/sizecheck.h"
+#include "support.h"
+
+extern char **environ;
+
+/* The estimate of render's command line (after "render"), for jobs POV-Ray processes. */
+static size_estimate estimate_of(char **args, int n, int jobs)
+{
+    char *argv[64] = {"lens2pov", "render"};
+    cr_assert(n + 2 <= 64);
+    memcpy(argv + 2, args, sizeof *args * (size_t)n);
+    cli c;
+    l2p_error err;
+    cr_assert_eq(cli_parse(&c, n + 2, argv, 2, &err), 0, "%s", err.text);
+    return size_estimate_of(&c, jobs);
+}
+
+/* Every file in dir: their bytes, and the faces of the distribution-3 includes among them. */
+static void workspace_size(const char *dir, double *bytes, double *faces)
+{
+    *bytes = *faces = 0;
+    DIR *d = opendir(dir);
+    cr_assert_not_null(d, "%s", dir);
+    for (struct dirent *e; (e = readdir(d)) != NULL;) {
+        char path[2048];
+        struct stat sb;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode))
+            continue;
+        *bytes += (double)sb.st_size;
+        const size_t n = strlen(e->d_name);
+        if (n > 4 && !strcmp(e->d_name + n - 4, ".inc")) {
+            char *text = read_text(path, NULL);
+            const char *p = text ? strstr(text, "face_indices {") : NULL;
+            cr_assert_not_null(p, "%s has no faces", path);
+            *faces += strtod(p + 14, NULL);
+            free(text);
+        }
+    }
+    closedir(d);
+}
+
+/* POV-Ray on one of the workspace's renders, as render runs it; its peak resident size in
+   bytes. */
+static double povray_peak_bytes(const char *work, int r)
+{
+    char ini[1200], wrapper[1200], out[1200];
+    snprintf(ini, sizeof ini, "%s/field.f%03d.ini", work, r);
+    snprintf(wrapper, sizeof wrapper, "+I%s/povray.c%03d.pov", work, r);
+    snprintf(out, sizeof out, "+O%s/again.exr", work);
+    char *argv[] = {"povray", ini, wrapper, out, "-D", "-GA", NULL};
+    pid_t pid;
+    cr_assert_eq(posix_spawnp(&pid, "povray", NULL, NULL, argv, environ), 0);
+    int status;
+    struct rusage ru;
+    cr_assert_eq(wait4(pid, &status, 0, &ru), pid);
+    cr_assert(WIFEXITED(status) && WEXITSTATUS(status) == 0, "povray on render %d failed", r);
+    return (double)ru.ru_maxrss * 1024.0;   /* Linux gives kilobytes */
+}
+
+/* A field render of the fisheye (whose image circle's edge takes the most faces) with --rays:
+   its includes' faces, its workspace (includes, inis, weights, renders, wrapper scenes, logs),
+   its CSV and every POV-Ray process's peak memory stay within the estimate made before it. */
+Test(sizecheck, a_field_render_stays_within_its_estimate)
+{
+    const char *dir = test_tmpdir();
+    char scene[1024], work[1024], csv[1024], out[1024];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(work, sizeof work, "%s/work", dir);
+    snprintf(csv, sizeof csv, "%s/rays.csv", dir);
+    snprintf(out, sizeof out, "%s/out.exr", dir);
+    write_text(scene, "#version 3.7;\nbackground { rgb <0.2, 0.4, 0.8> }\n");
+    char *args[] = {scene, LENS_DIR "fisheye.10mm.dat", "--width", "320", "--height", "240", "--spp", "4",
+                    "--location", "0,1,-4", "--look-at", "0,1,0", "--sampling", "field", "--jobs", "2",
+                    "--keep-temp", work, "--rays", csv, "--quiet", "-o", out};
+    const int n = sizeof args / sizeof args[0];
+    const size_estimate e = estimate_of(args, n, 2);
+    char *argv[64] = {"render"};
+    memcpy(argv + 1, args, sizeof args);
+    char *errtext = NULL;
+    cr_assert_eq(run_lens2pov_argv(NULL, &errtext, argv), 0, "%s", errtext ? errtext : "");
+    free(errtext);
+    double bytes, faces;
+    workspace_size(work, &bytes, &faces);
+    struct stat sb;
+    cr_assert_eq(stat(csv, &sb), 0);
+    cr_log_info("faces %.0f (estimate %.0f), workspace %.0f bytes (%.0f), CSV %.0f (%.0f)", faces, e.faces, bytes,
+                e.table_bytes + e.renders_bytes, (double)sb.st_size, e.csv_bytes);
+    cr_expect_leq(faces, e.faces);
+    cr_expect_leq(bytes, e.table_bytes + e.renders_bytes);
+    cr_expect_leq((double)sb.st_size, e.csv_bytes);
+    for (int r = 0; r < 4; r++) {
+        char inc[1200];
+        snprintf(inc, sizeof inc, "%s/field.f%03d.inc", work, r);
+        if (!file_exists(inc))
+            break;
+        const double peak = povray_peak_bytes(work, r);
+        cr_log_info("render %d: POV-Ray peak %.1f MB (estimate %.1f MB)", r, peak / 1e6, e.povray_process_bytes / 1e6);
+        cr_expect_leq(peak, e.povray_process_bytes, "render %d: POV-Ray took %.0f bytes", r, peak);
+    }
+    cr_expect_leq(e.povray_process_bytes, e.memory_bytes);
+}
+
+/* The smallest power of two above n: POV-Ray's side of a render whose final side holds n. */
+static double render_side(int n)
+{
+    double p = 1;
+    while (p < n + 1)
+        p *= 2;
+    return p;
+}
+
+/* Each sub-image's render is its own size: (2^a) x (2^b) pixels, the final picture 2^a - 1 by
+   2^b - 1 holding the crop (docs/fields.md), 8 bytes a pixel, whatever the film around the
+   crop; and the faces are not pixel sampling's one a sample. */
+Test(sizecheck, field_renders_are_estimated_at_their_own_size)
+{
+    static const int sides[][2] = {{511, 255}, {512, 256}, {100, 700}, {1, 1}};
+    for (size_t i = 0; i < sizeof sides / sizeof sides[0]; i++) {
+        char w[16], h[16], crop[64];
+        snprintf(w, sizeof w, "%d", sides[i][0] + 40);
+        snprintf(h, sizeof h, "%d", sides[i][1] + 30);
+        snprintf(crop, sizeof crop, "40,30,%d,%d", sides[i][0] + 40, sides[i][1] + 30);
+        char *field[] = {"s.pov", "dgauss.50mm", "--width", w, "--height", h, "--crop", crop, "--spp", "64",
+                         "--sampling", "field", "-o", "x.png"};
+        char *pixel[] = {"s.pov", "dgauss.50mm", "--width", w, "--height", h, "--crop", crop, "--spp", "64",
+                         "-o", "x.png"};
+        const size_estimate f = estimate_of(field, 14, 2), p = estimate_of(pixel, 12, 2);
+        const double want = 64 * render_side(sides[i][0]) * render_side(sides[i][1]) * SIZE_EXR_BYTES_PER_FACE;
+        cr_expect_eq(f.renders_bytes, want, "crop %dx%d: %.0f bytes of renders, expected %.0f", sides[i][0],
+                     sides[i][1], f.renders_bytes, want);
+        cr_expect_leq(f.faces, p.faces, "crop %dx%d: %.0f faces against %.0f", sides[i][0], sides[i][1], f.faces,
+                     p.faces);
+    }
+}
