@@ -29,7 +29,8 @@ IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbo
                  -Wl,--export-dynamic-symbol=outfile_create_temp
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
-               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core libxml2-utils
+               pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core libxml2-utils \
+               time
 
 # The sources, one folder per stage of the data flow (docs/source.md).
 LIB_C   = $(filter-out src/cli/main.c,$(wildcard src/*/*.c))
@@ -37,8 +38,8 @@ LIB_OBJ = $(LIB_C:src/%.c=$(BUILD)/obj/%.o)
 TEST_C  = $(wildcard tests/*.c)
 TEST_OBJ = $(TEST_C:tests/%.c=$(BUILD)/tobj/%.o)
 
-.PHONY: all deps test test-unit test-sanitize test-extra bench demo gallery report stability fuzz \
-        valgrind install clean
+.PHONY: all deps test test-unit test-sanitize test-extra bench bench-field-error demo gallery report \
+        stability fuzz valgrind install clean
 
 all: $(BUILD)/lens2pov
 
@@ -98,6 +99,11 @@ test-sanitize: deps
 
 bench: deps $(BUILD)/lens2pov $(BUILD)/bench_trace
 	sh tools/bench.sh $(BUILD)
+
+# Ray fields' error against time on the four standard lenses (tools/bench_field_error.sh):
+# longer than the rest of make bench, so a target of its own.
+bench-field-error: deps $(BUILD)/lens2pov
+	sh tools/bench_field_error.sh $(BUILD)
 
 $(BUILD)/bench_trace: tools/bench_trace.c $(BUILD)/liblens2pov.a
 	$(CC) $(CFLAGS_BASE) $^ -o $@ $(LDLIBS)

@@ -2,9 +2,11 @@
 # make bench: the tracer's figures; lens2pov trace against POV-Ray's parse of the same
 # 1e6-ray include (the target: trace at no more than 10% of POV-Ray's time); lens2pov render
 # against POV-Ray's own camera on the same view and primary rays (target: 1.5 or less), and
-# one POV-Ray process against two; then an animation (tools/bench_anim.sh).
+# one POV-Ray process against two; then an animation (tools/bench_anim.sh) and ray fields
+# (tools/bench_field.sh; their error against time is make bench-field-error).
 set -e
 build=${1:-build}
+echo "processor: $(sed -n 's/^model name[^:]*: *//p' /proc/cpuinfo | head -1), $(nproc) cores"
 work=$(mktemp -d "${TMPDIR:-/tmp}/l2pbench.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 "$build/bench_trace" lenses "$work"
@@ -77,3 +79,4 @@ awk -v a="$(middle $one_t)" -v b="$(middle $lens_t)" -v r="$(middle $speedup)" '
   printf "chunked parallel parse: --jobs 1: %.2f s, --jobs 2: %.2f s, speed-up %.2f\n", a, b, r }'
 
 sh tools/bench_anim.sh "$build"
+L2P_BENCH_CPU_SHOWN=1 sh tools/bench_field.sh "$build"
