@@ -489,3 +489,58 @@ Test(dispersion, a_white_background_stays_neutral, .timeout = 300)
             free(rgba);
         }
 }
+
+/* Every ray of a trace with dispersion was traced at the wavelength its CSV row gives: traced
+   back from the scene through the lens taken to that wavelength it lands on its film point
+   (to 1e-6 mm), where at the d line it lands off it (or is blocked); every band of the
+   spectrum is drawn as often. */
+Test(dispersion, each_ray_is_traced_at_its_rows_wavelength)
+{
+    const char *dir = test_tmpdir();
+    const char *prefix = tmp_path(dir, "t"), *csv = tmp_path(dir, "t.csv");
+    run_lens2pov_ok("trace", "trace", LENS_DIR "cooke-triplet.50mm.dat", "--width", "12",
+                    "--height", "9", "--spp", "8", "--rays", csv, "--quiet", "-o", prefix, NULL);
+    char *text = read_text(csv, NULL);
+    cr_assert_not_null(text);
+    cr_assert(!strncmp(text, "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,dir_x,"
+                             "dir_y,dir_z,weight,wavelength_nm\n", 87), "header: %.100s", text);
+    camera c;
+    test_camera(&c, "cooke-triplet.50mm", NULL);
+    int rows = 0, off_at_d = 0, in_band[8] = {0};
+    for (const char *line = strchr(text, '\n') + 1; *line; line = strchr(line, '\n') + 1) {
+        double v[12];
+        cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1],
+                            &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]), 12);
+        for (int b = 0; b < 8; b++)
+            in_band[b] += v[11] >= spectrum_wavelength_nm(b / 8.0) &&
+                          v[11] < spectrum_wavelength_nm((b + 1) / 8.0);
+        double miss[2];
+        for (int d_line = 0; d_line < 2; d_line++) {
+            lens at;
+            cr_assert_eq(lens_copy(&at, &c.lens), 0);
+            lens_at_wavelength(&at, d_line ? WAVELENGTH_D_NM : v[11]);
+            const vec3 dir_out = v3(v[7], v[8], v[9]);
+            ray r = {v3_add(v3(v[4], v[5], v[6]), dir_out), v3_scale(dir_out, -1.0)};
+            const trace_status st = trace_toward_film(&at, 0, at.count - 1, &r, NULL);
+            cr_assert(st == TRACE_PASSED || d_line, "row %d does not get back through", rows);
+            const double t = -r.o.z / r.d.z;
+            miss[d_line] = st != TRACE_PASSED ? INFINITY
+                                              : hypot(r.o.x + t * r.d.x - v[2], r.o.y + t * r.d.y - v[3]);
+            lens_free(&at);
+        }
+        cr_expect(miss[0] < 1e-6, "row %d at %g nm lands %g mm from its film point", rows, v[11],
+                  miss[0]);
+        off_at_d += miss[1] > 1e-4;
+        rows++;
+    }
+    camera_free(&c);
+    free(text);
+    cr_assert(rows > 400, "%d rows", rows);
+    cr_expect(off_at_d > rows / 2, "at the d line only %d of %d rows land off their film points",
+              off_at_d, rows);
+    /* each pixel's 8 samples take the 8 bands once each: the bands are as full as each other,
+       but for the few samples the lens blocks */
+    for (int b = 0; b < 8; b++)
+        cr_expect(fabs(in_band[b] - rows / 8.0) < 0.1 * rows / 8.0, "band %d holds %d of %d rows",
+                  b, in_band[b], rows);
+}
