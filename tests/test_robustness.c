@@ -140,6 +140,7 @@ static const bad_line BAD_OPTIONS[] = {
     {{"trace", DGAUSS, "--aperture-blades", "-1", "-o", "OUT"}, "--aperture-blades"},
     {{"trace", DGAUSS, "--blade-rotation", "x", "-o", "OUT"}, "--blade-rotation"},
     {{"trace", DGAUSS, "--aperture-blades", "6", "--trace", "thick", "-o", "OUT"}, "--trace full"},
+    {{"trace", DGAUSS, "--sampling", "field", "--memory-mb", "10", "-o", "OUT"}, "--memory-mb"},
     /* dispersion and wavelengths */
     {{"trace", DGAUSS, "--dispersion", "on", "-o", "OUT"}, "Abbe numbers"},
     {{"trace", COOKE, "--dispersion", "on", "--trace", "thick", "-o", "OUT"}, "--trace full"},

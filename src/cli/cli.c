@@ -74,10 +74,10 @@ static const cli_option OPTIONS[] = {
      "                                rendered pixel's exact ray and its render pixel [none]\n"},
     {"--scene", NULL, CMD_TRACE, false, false,
      "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"},
-    {"--sampling", NULL, CMD_RENDER, false, false,
+    {"--sampling", NULL, CMD_SAMPLES, false, false,
      "  --sampling pixel|field        exact rays, or ray fields: spp sub-images of shared\n"
      "                                samples drawn by coarse meshes [pixel]\n"},
-    {"--field-tolerance", NULL, CMD_RENDER, false, false,
+    {"--field-tolerance", NULL, CMD_SAMPLES, false, false,
      "  --field-tolerance PX          field rays' largest error, in pixels [0.05]\n"},
     {"--keep-temp", NULL, CMD_RENDER, false, false,
      "  --keep-temp DIR               keep the ray tables, renders and logs [removed]\n"},

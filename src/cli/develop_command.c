@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/outfile.h"
+#include "field/field_develop.h"
 #include "image/develop.h"
 #include "image/samplemap.h"
 #include "raytable/chunk_name.h"
@@ -32,6 +33,38 @@ static char **render_names(const cli *c, long long chunks, l2p_error *err)
     return names;
 }
 
+/* A field map's renders: as given, or PREFIX.f000.exr, PREFIX.f001.exr, ... (the names its
+   .ini files give POV-Ray). */
+static int develop_field(const cli *c, const char *map_path, l2p_error *err)
+{
+    field_map m;
+    int st = field_map_read(map_path, &m, err);
+    if (st)
+        return st;
+    const char *prefix = c->positional[0];
+    const int given = c->positional_count - 1;
+    char **names = calloc((size_t)m.renders, sizeof *names);
+    for (int r = 0; names && r < m.renders; r++) {
+        if (given) {
+            names[r] = r < given ? strdup(c->positional[r + 1]) : strdup("");
+        } else if ((names[r] = malloc(strlen(prefix) + 16))) {
+            sprintf(names[r], "%s.f%03d.exr", prefix, r);
+        }
+        if (!names[r])
+            break;
+    }
+    if (!names || (m.renders && !names[m.renders - 1]))
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    else
+        st = field_develop(&m, (const char *const *)names, given ? given : m.renders, c->output,
+                           err);
+    for (int r = 0; names && r < m.renders; r++)
+        free(names[r]);
+    free(names);
+    field_map_free(&m);
+    return st;
+}
+
 int develop_command(const cli *c, l2p_error *err)
 {
     if (c->positional_count < 1 || !c->output)
@@ -43,6 +76,11 @@ int develop_command(const cli *c, l2p_error *err)
     if (!map_path)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     sprintf(map_path, "%s.map", c->positional[0]);
+    if (field_map_is_one(map_path)) {
+        st = develop_field(c, map_path, err);
+        free(map_path);
+        return st;
+    }
     samplemap map;
     st = samplemap_read(map_path, &map, err);
     free(map_path);

@@ -1,5 +1,6 @@
-/* render --sampling field: sub-images built on worker threads, packed into POV-Ray renders of
-   at most FIELD_FACES_PER_RENDER faces, rendered by the chunk runner, developed here. */
+/* render and trace --sampling field: sub-images built on worker threads, their weights into
+   the field map, packed into POV-Ray renders of at most FIELD_FACES_PER_RENDER faces; render
+   runs them through the chunk runner and develops them from the map (field_develop.c). */
 #include "field/field_render.h"
 
 #include <pthread.h>
@@ -7,8 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "field/field_develop.h"
+#include "field/fieldmap.h"
 #include "field/fieldrays.h"
 #include "field/subimage.h"
+#include "raytable/chunk_ini.h"
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "optics/pupil.h"
@@ -17,8 +21,8 @@
 
 typedef struct sub {
     field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
-    float *weights;            /* one a crop pixel, while building; then in its file */
-    double colour[3];          /* its wavelength band's colour weights, with dispersion */
+    float *weights;            /* one a crop pixel, while building; then in the map */
+    uint32_t band;             /* its wavelength band, with dispersion */
     field_stats stats;
     field_placement at;        /* where it is rendered */
 } sub;
@@ -31,7 +35,8 @@ typedef struct render_plan {
 
 typedef struct job {
     const camera *c;
-    const char *work_dir;
+    const outfile *map;        /* the field map, its weights written as sub-images are built */
+    const samplemap_header *header;
     const field_tolerance *tol;
     sub *subs;
     int spp;
@@ -43,40 +48,14 @@ typedef struct job {
 
 /* ---------------------------------------------------------------- building */
 
-/* WORK/field.fNNN.EXT: render NNN's include, ini and EXR, or sub-image NNN's weights. */
-static char *name_of(const char *dir, int k, const char *ext)
+/* PREFIX.fNNN.EXT: render NNN's include, ini or picture. */
+static char *name_of(const char *prefix, int k, const char *ext)
 {
-    size_t n = strlen(dir) + 32;
+    size_t n = strlen(prefix) + 32;
     char *s = malloc(n);
     if (s)
-        snprintf(s, n, "%s/field.f%03d.%s", dir, k, ext);
+        snprintf(s, n, "%s.f%03d.%s", prefix, k, ext);
     return s;
-}
-
-/* A sub-image's weights go to the workspace (WORK/field.fNNN.weights, raw float32) until
-   developing: spp of them in memory would be spp times the picture. */
-static int save_weights(const job *j, int k, const float *weights, size_t n, l2p_error *e)
-{
-    char *path = name_of(j->work_dir, k, "weights");
-    FILE *f = path ? fopen(path, "wb") : NULL;
-    bool ok = f && fwrite(weights, sizeof *weights, n, f) == n;
-    if (f && fclose(f) != 0)
-        ok = false;
-    int st = ok ? L2P_OK : l2p_fail(e, L2P_FAILED, path, 0, "cannot write");
-    free(path);
-    return st;
-}
-
-static int load_weights(const char *dir, int k, float *weights, size_t n, l2p_error *err)
-{
-    char *path = name_of(dir, k, "weights");
-    FILE *f = path ? fopen(path, "rb") : NULL;
-    bool ok = f && fread(weights, sizeof *weights, n, f) == n;
-    if (f)
-        fclose(f);
-    int st = ok ? L2P_OK : l2p_fail(err, L2P_FAILED, path, 0, "cannot read");
-    free(path);
-    return st;
 }
 
 static void *build_worker(void *arg)
@@ -87,7 +66,7 @@ static void *build_worker(void *arg)
         sub *s = &j->subs[k];
         l2p_error e;
         s->weights = malloc(pixels * sizeof *s->weights);
-        const film_sample shared = field_shared_sample(j->c, k, s->colour);
+        const film_sample shared = field_shared_sample(j->c, k, &s->band);
         int st = s->weights ? field_build_subimage(j->c, shared, j->tol, FIELD_BASE_CELL, &s->mesh,
                                                    s->weights, &s->stats, &e)
                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
@@ -100,8 +79,8 @@ static void *build_worker(void *arg)
                           "--field-tolerance %g needs %d faces for %zu pixels in sub-image %d: "
                           "use a larger tolerance or --sampling pixel", j->tol->pixels,
                           s->stats.faces, pixels, k);
-        if (!st)
-            st = save_weights(j, k, s->weights, pixels, &e);
+        if (!st)   /* into the map now: spp of them in memory would be spp pictures */
+            st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
         free(s->weights);
         s->weights = NULL;
         if (st) {
@@ -194,10 +173,9 @@ static void world_matrix(const camera *c, double m[12])
     m[9] = t.x, m[10] = t.y, m[11] = t.z;
 }
 
-/* The render's include (its sub-images moved into place) and its ini: (W+1) x (H+1) pixels,
-   rows 2.. and columns ..W only (FS#261, docs/povray.md). */
-static int write_render(const camera *c, const sub *subs, const render_plan *p, const povray_chunk *ch,
-                        l2p_error *err)
+/* The include of render p: its sub-images moved into place. */
+static int write_include(const camera *c, const sub *subs, const render_plan *p, outfile *f,
+                         l2p_error *err)
 {
     field_mesh m;
     field_mesh_init(&m, p->width, p->height);
@@ -209,30 +187,35 @@ static int write_render(const camera *c, const sub *subs, const render_plan *p, 
     }
     double world[12];
     world_matrix(c, world);
-    FILE *f = st ? NULL : fopen(ch->include_path, "w");
-    if (!st && (!f || field_mesh_write_include(f, &m, "Lens2pov_Field", world) < 0))
-        st = l2p_fail(err, L2P_FAILED, ch->include_path, 0, "cannot write");
-    if (f && fclose(f) != 0 && !st)
-        st = l2p_fail(err, L2P_FAILED, ch->include_path, 0, "cannot write");
+    if (!st && field_mesh_write_include(f->fp, &m, "Lens2pov_Field", world) < 0)
+        st = l2p_fail(err, L2P_FAILED, f->final_path, 0, "cannot write");
     field_mesh_free(&m);
-    f = st ? NULL : fopen(ch->ini_path, "w");
-    if (!st && !f)
-        return l2p_fail(err, L2P_FAILED, ch->ini_path, 0, "cannot write");
-    if (f) {
-        const bool q = povray_ini_needs_quotes(ch->output_exr);
-        fprintf(f, "; lens2pov: a ray-field render, final pixel (x, y) at image pixel (x, y + 1)\n"
+    return st ? st : outfile_finish(f, err);
+}
+
+/* Its ini: (W+1) x (H+1) pixels, rows 2.. and columns ..W only (FS#261, docs/povray.md), the
+   picture named by its absolute path. */
+static int write_ini(const render_plan *p, const char *exr, outfile *f, l2p_error *err)
+{
+    char *path = chunk_ini_absolute(exr);
+    if (!path)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    if (!povray_ini_can_carry(path)) {
+        free(path);
+        return l2p_fail(err, L2P_BAD_INPUT, exr, 0, "POV-Ray's .ini cannot name this file: choose "
+                        "another name");
+    }
+    const char *q = povray_ini_needs_quotes(path) ? "\"" : "";
+    fprintf(f->fp, "; lens2pov: a ray-field render, final pixel (x, y) at image pixel (x, y + 1)\n"
                    "Width=%d\nHeight=%d\nStart_Row=2\nEnd_Column=%d\nAntialias=Off\n"
                    "Output_File_Type=E\nOutput_To_File=On\nOutput_File_Name=%s%s%s\nDisplay=Off\n",
-                p->width + 1, p->height + 1, p->width, q ? "\"" : "", ch->output_exr, q ? "\"" : "");
-        if (fclose(f) != 0)
-            st = l2p_fail(err, L2P_FAILED, ch->ini_path, 0, "cannot write");
-    }
-    return st;
+            p->width + 1, p->height + 1, p->width, q, path, q);
+    free(path);
+    return outfile_finish(f, err);
 }
 
 /* --rays: written once the sub-images have their renders, before POV-Ray runs, so that a
-   disk too full for it fails the render at once; the caller renames it into place when the
-   render succeeds. */
+   disk too full for it fails at once; the caller renames it into place on success. */
 static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l2p_error *err)
 {
     field_placement *at = malloc(sizeof *at * (size_t)spp);
@@ -245,122 +228,202 @@ static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l
     return st ? st : outfile_finish(csv, err);
 }
 
-/* ---------------------------------------------------------------- developing */
-
-static int develop_render(const render_plan *p, const sub *subs, const char *exr, const char *dir,
-                          int w, int h, size_t stride, double *sums, l2p_error *err)
+/* The map's tables: each render's size, each sub-image's place and band. */
+static int finish_map(const camera *c, const sub *subs, const render_plan *plans, int renders,
+                      const outfile *f, l2p_error *err)
 {
-    int iw, ih;
-    float *rgba, *weights = malloc(sizeof *weights * (size_t)w * h);
-    if (!weights)
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    int st = image_read_rgba(exr, &iw, &ih, &rgba, err);
-    if (st) {
-        free(weights);
-        return st;
-    }
-    if (iw != p->width + 1 || ih != p->height + 1) {
-        free(rgba), free(weights);
-        return l2p_fail(err, L2P_FAILED, exr, 0, "is %dx%d, not %dx%d", iw, ih, p->width + 1, p->height + 1);
-    }
-    for (int i = 0; i < p->count && !st; i++) {
-        const sub *s = &subs[p->first + i];
-        if ((st = load_weights(dir, p->first + i, weights, (size_t)w * h, err)))
-            break;
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) {
-                const float wt = weights[(size_t)y * w + x];
-                if (wt <= 0)
-                    continue;   /* blocked: no face, black */
-                const float *px = rgba + 4 * ((size_t)(s->at.dy + y + 1) * iw + s->at.dx + x);
-                develop_add(sums + stride * ((size_t)y * w + x), stride > 3 ? s->colour : NULL,
-                            (double)wt, px);
-            }
-    }
-    free(rgba), free(weights);
+    const int spp = c->samples.spp;
+    field_map m = {.renders = renders};
+    povmesh_camera_header(c, &m.header);
+    m.width = malloc(sizeof *m.width * (size_t)renders);
+    m.height = malloc(sizeof *m.height * (size_t)renders);
+    m.at = malloc(sizeof *m.at * (size_t)spp);
+    m.band = malloc(sizeof *m.band * (size_t)spp);
+    int st = m.width && m.height && m.at && m.band ? L2P_OK
+             : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int r = 0; !st && r < renders; r++)
+        m.width[r] = plans[r].width, m.height[r] = plans[r].height;
+    for (int k = 0; !st && k < spp; k++)
+        m.at[k] = subs[k].at, m.band[k] = subs[k].band;
+    if (!st)
+        st = field_map_finish(f, &m, err);
+    field_map_free(&m);
     return st;
 }
 
 /* ---------------------------------------------------------------- the whole */
 
-static int render_and_develop(const camera *c, const field_render_options *o, sub *subs,
-                              const render_plan *plans, int renders, l2p_error *err)
+/* The outputs of a field render or trace, all under temporary names until committed: the map,
+   and for each render its include and ini (PREFIX.fNNN.inc, .ini), its picture's name. */
+typedef struct field_files {
+    outfile map;
+    char *map_path;            /* the map's final path (outfile forgets it once committed) */
+    outfile *inc, *ini;
+    povray_chunk *chunk;       /* include, ini and picture paths, faces */
+    int renders;
+} field_files;
+
+/* Removes what was not committed, frees the rest. */
+static void files_free(field_files *f)
 {
-    const int w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
-    povray_chunk *ch = calloc((size_t)renders, sizeof *ch);
-    int st = ch ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int r = 0; r < renders && !st; r++) {
-        ch[r] = (povray_chunk){.include_path = name_of(o->work_dir, r, "inc"),
-                               .ini_path = name_of(o->work_dir, r, "ini"),
-                               .output_exr = name_of(o->work_dir, r, "exr"),
-                               .faces = plans[r].faces};
-        if (!ch[r].include_path || !ch[r].ini_path || !ch[r].output_exr)
-            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-        else
-            st = write_render(c, subs, &plans[r], &ch[r], err);
+    outfile_discard(&f->map);
+    for (int r = 0; r < f->renders; r++) {
+        outfile_discard(&f->inc[r]), outfile_discard(&f->ini[r]);
+        free((char *)f->chunk[r].include_path), free((char *)f->chunk[r].ini_path);
+        free((char *)f->chunk[r].output_exr);
     }
-    /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
-    const povray_options po = {.scene_path = o->scene_path, .work_dir = o->work_dir,
-                               .jobs = o->jobs, .threads_per_job = o->threads_per_job,
-                               .show_progress = o->progress, .film_width = c->film.width,
-                               .film_height = c->film.height};
+    free(f->inc), free(f->ini), free(f->chunk), free(f->map_path);
+    memset(f, 0, sizeof *f);
+}
+
+static int files_commit(field_files *f, l2p_error *err)
+{
+    int st = outfile_commit(&f->map, err);
+    for (int r = 0; r < f->renders && !st; r++)
+        if (!(st = outfile_commit(&f->inc[r], err)))
+            st = outfile_commit(&f->ini[r], err);
+    return st;
+}
+
+/* Builds the sub-images (weights into the map), packs them and writes every render's include
+   and ini and the map's tables, under temporary names. */
+static int build_files(const camera *c, double tolerance_px, int jobs, const char *prefix,
+                       field_files *out, sub **subs_out, l2p_error *err)
+{
+    if (!(tolerance_px > 0) || !isfinite(tolerance_px))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--field-tolerance must be a number of pixels "
+                        "above 0 (for exact rays, use --sampling pixel)");
+    const int spp = c->samples.spp, w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
+    jobs = jobs > 0 ? jobs : 1;
+    field_tolerance tol;
+    field_tolerance_of(c, tolerance_px, &tol);
+    samplemap_header header;
+    povmesh_camera_header(c, &header);
+    sub *subs = calloc((size_t)spp, sizeof *subs);
+    render_plan *plans = calloc((size_t)spp, sizeof *plans);
+    char *map_path = malloc(strlen(prefix) + 8);
+    memset(out, 0, sizeof *out);
+    *subs_out = subs;
+    if (!subs || !plans || !map_path) {
+        free(plans), free(map_path);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
+    for (int k = 0; k < spp; k++)
+        field_mesh_init(&subs[k].mesh, field_render_size(w), field_render_size(h));
+    sprintf(map_path, "%s.map", prefix);
+    out->map_path = map_path;
+    int st = outfile_open(&out->map, map_path, err);
     if (!st)
-        st = povray_render_chunks(ch, renders, &po, err);
-    samplemap map = {.records = NULL};
-    povmesh_camera_header(c, &map.header);
-    const size_t stride = develop_sums_per_pixel(&map.header);
-    double *sums = st ? NULL : calloc(stride * (size_t)w * h, sizeof *sums);
-    if (!st && !sums)
+        st = field_map_begin(&out->map, &header, err);
+    job j = {.c = c, .map = &out->map, .header = &header, .tol = &tol, .subs = subs, .spp = spp};
+    atomic_init(&j.next, 0);
+    atomic_init(&j.status, L2P_OK);
+    pthread_mutex_init(&j.lock, NULL);
+    if (!st)
+        st = build_all(&j, jobs, err);
+    pthread_mutex_destroy(&j.lock);
+    const int renders = st ? 0 : pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
+    if (!st)
+        st = finish_map(c, subs, plans, renders, &out->map, err);
+    if (!st)
+        st = outfile_finish(&out->map, err);
+    out->inc = calloc((size_t)renders + 1, sizeof *out->inc);
+    out->ini = calloc((size_t)renders + 1, sizeof *out->ini);
+    out->chunk = calloc((size_t)renders + 1, sizeof *out->chunk);
+    if (!st && (!out->inc || !out->ini || !out->chunk))
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int r = 0; r < renders && !st; r++)
-        st = develop_render(&plans[r], subs, ch[r].output_exr, o->work_dir, w, h, stride, sums, err);
+    for (int r = 0; r < renders && !st; r++, out->renders++) {
+        povray_chunk *ch = &out->chunk[r];
+        *ch = (povray_chunk){.include_path = name_of(prefix, r, "inc"),
+                             .ini_path = name_of(prefix, r, "ini"),
+                             .output_exr = name_of(prefix, r, "exr"), .faces = plans[r].faces};
+        if (!ch->include_path || !ch->ini_path || !ch->output_exr)
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+        if (!st && !(st = outfile_open(&out->inc[r], ch->include_path, err)))
+            st = write_include(c, subs, &plans[r], &out->inc[r], err);
+        if (!st && !(st = outfile_open(&out->ini[r], ch->ini_path, err)))
+            st = write_ini(&plans[r], ch->output_exr, &out->ini[r], err);
+    }
+    free(plans);
+    return st;
+}
+
+static void subs_free(sub *subs, int spp)
+{
+    for (int k = 0; subs && k < spp; k++)
+        field_mesh_free(&subs[k].mesh), free(subs[k].weights);
+    free(subs);
+}
+
+/* Develops the renders from the map in the workspace, as `develop` does from files. */
+static int develop_from_map(const field_files *f, const char *output, l2p_error *err)
+{
+    field_map m;
+    int st = field_map_read(f->map_path, &m, err);
+    const char **exr = st ? NULL : malloc(sizeof *exr * (size_t)f->renders + 1);
+    if (!st && !exr)
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int r = 0; !st && r < f->renders; r++)
+        exr[r] = f->chunk[r].output_exr;
     if (!st)
-        st = develop_write_picture(&map, sums, o->output, err);
-    free(sums);
-    for (int r = 0; ch && r < renders; r++)
-        free((char *)ch[r].include_path), free((char *)ch[r].ini_path), free((char *)ch[r].output_exr);
-    free(ch);
+        st = field_develop(&m, exr, f->renders, output, err);
+    free(exr);
+    field_map_free(&m);
     return st;
 }
 
 int field_render(const camera *c, const field_render_options *o, l2p_error *err)
 {
-    if (!(o->tolerance_px > 0) || !isfinite(o->tolerance_px))
-        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
-                        "--field-tolerance must be a number of pixels above 0 (for exact rays, use --sampling pixel)");
-    const int spp = c->samples.spp, w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
-    field_tolerance tol;
-    field_tolerance_of(c, o->tolerance_px, &tol);
-    sub *subs = calloc((size_t)spp, sizeof *subs);
-    render_plan *plans = calloc((size_t)spp, sizeof *plans);
-    if (!subs || !plans) {
-        free(subs), free(plans);
+    char *prefix = malloc(strlen(o->work_dir) + 8);
+    if (!prefix)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    }
-    for (int k = 0; k < spp; k++)
-        field_mesh_init(&subs[k].mesh, field_render_size(w), field_render_size(h));
-    job j = {.c = c, .work_dir = o->work_dir, .tol = &tol, .subs = subs, .spp = spp};
-    atomic_init(&j.next, 0);
-    atomic_init(&j.status, L2P_OK);
-    pthread_mutex_init(&j.lock, NULL);
-    int st = build_all(&j, o->jobs > 0 ? o->jobs : 1, err);
-    pthread_mutex_destroy(&j.lock);
+    sprintf(prefix, "%s/field", o->work_dir);
+    field_files f;
+    sub *subs = NULL;
+    int st = build_files(c, o->tolerance_px, o->jobs, prefix, &f, &subs, err);
+    free(prefix);
     /* the image library, loading on render's thread meanwhile: fail before POV-Ray runs when
        it cannot be loaded, and never leave while it is half loaded */
     l2p_error lib_err;
     const int lib = image_io_ready(&lib_err);
     if (!st && lib)
         st = l2p_fail(err, lib, NULL, 0, "%s", lib_err.text);
-    if (!st) {
-        const int jobs = o->jobs > 0 ? o->jobs : 1;
-        int renders = pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
-        if (o->rays_csv)
-            st = write_rays(c, subs, spp, o->rays_csv, err);
-        if (!st)
-            st = render_and_develop(c, o, subs, plans, renders, err);
+    if (!st)
+        st = files_commit(&f, err);   /* the workspace's: in place at once */
+    if (!st && o->rays_csv)
+        st = write_rays(c, subs, c->samples.spp, o->rays_csv, err);
+    subs_free(subs, c->samples.spp);
+    /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
+    const povray_options po = {.scene_path = o->scene_path, .work_dir = o->work_dir,
+                               .jobs = o->jobs, .threads_per_job = o->threads_per_job,
+                               .show_progress = o->progress, .film_width = c->film.width,
+                               .film_height = c->film.height};
+    if (!st)
+        st = povray_render_chunks(f.chunk, f.renders, &po, err);
+    if (!st)
+        st = develop_from_map(&f, o->output, err);
+    files_free(&f);
+    return st;
+}
+
+int field_trace(const camera *c, const field_trace_options *o, field_trace_stats *stats,
+                l2p_error *err)
+{
+    field_files f;
+    sub *subs = NULL;
+    int st = build_files(c, o->tolerance_px, o->jobs, o->prefix, &f, &subs, err);
+    if (!st && o->rays_csv)
+        st = write_rays(c, subs, c->samples.spp, o->rays_csv, err);
+    if (!st)
+        st = files_commit(&f, err);
+    memset(stats, 0, sizeof *stats);
+    stats->renders = f.renders;
+    for (int k = 0; !st && k < c->samples.spp; k++) {
+        stats->faces += subs[k].stats.faces;
+        stats->passed += subs[k].stats.passed;
+        stats->pixels += subs[k].stats.passed + subs[k].stats.blocked;
     }
-    for (int k = 0; k < spp; k++)
-        field_mesh_free(&subs[k].mesh), free(subs[k].weights);
-    free(subs), free(plans);
+    subs_free(subs, c->samples.spp);
+    files_free(&f);
     return st;
 }

@@ -27,6 +27,27 @@ typedef struct field_render_options {
    POV-Ray's per-pixel face search grows with the faces in a UV grid cell. */
 enum { FIELD_FACES_PER_RENDER = 20000 };
 
+/* trace --sampling field: the map and the renders' includes and inis, for POV-Ray and
+   `develop` to take from there (docs/fields.md). */
+typedef struct field_trace_options {
+    const char *prefix;        /* PREFIX.map, PREFIX.fNNN.inc, PREFIX.fNNN.ini (picture .exr) */
+    int jobs;                  /* threads building meshes */
+    double tolerance_px;
+    outfile *rays_csv;         /* as field_render_options's */
+} field_trace_options;
+
+/* What a field trace wrote. */
+typedef struct field_trace_stats {
+    int renders;
+    long long faces;
+    long long pixels, passed;  /* pixels of all sub-images, and those whose ray passes */
+} field_trace_stats;
+
+/* Builds and writes the outputs, every one renamed into place only when all are complete.
+   The same refusals as field_render. */
+int field_trace(const camera *c, const field_trace_options *o, field_trace_stats *stats,
+                l2p_error *err);
+
 /* Builds, writes, renders and develops. L2P_BAD_INPUT naming --sampling pixel when the
    tolerance is not above 0 or a sub-image would need more faces than pixels; POV-Ray's errors
    as povray_render_chunks gives them. With rays_csv, the caller commits it on success. */

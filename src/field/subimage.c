@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "field/sobol.h"
-#include "optics/spectrum.h"
 
 void field_tolerance_of(const camera *c, double pixels, field_tolerance *t)
 {
@@ -52,16 +51,18 @@ void field_pixel_raster(const camera *c, film_sample s, long i, double *rx, doub
     *ry = c->crop_y0 + i / w + s.offset_y;
 }
 
-film_sample field_shared_sample(const camera *c, int k, double colour[3])
+film_sample field_shared_sample(const camera *c, int k, uint32_t *band)
 {
     film_sample s = sobol_shared_sample(c->samples.seed, (uint32_t)k);
+    uint32_t b = 0;
     if (c->dispersion) {
         const wavelength_sample w = sample_pattern_wavelength(&c->samples,
                                                               sample_pattern_shared(&c->samples), k);
         s.wavelength_nm = w.nm;
-        if (colour)
-            spectrum_band_weights(w.band, c->samples.spp, colour);
+        b = (uint32_t)w.band;
     }
+    if (band)
+        *band = b;
     return s;
 }
 

@@ -3,6 +3,7 @@
 #ifndef LENS2POV_FIELD_SUBIMAGE_H
 #define LENS2POV_FIELD_SUBIMAGE_H
 
+#include <stdint.h>
 #include "camera/camera.h"
 #include "field/fieldmesh.h"
 
@@ -52,9 +53,8 @@ void field_trace_pixels(const camera *c, film_sample s, long first, int n, sampl
 
 /* Sub-image k's shared sample: point k of the Owen-scrambled Sobol set; with dispersion also
    its wavelength, the bands dealt to the sub-images as pixel sampling deals them to a pixel's
-   samples (sample_pattern_wavelength), and colour gets its band's colour weights (left as
-   they are without dispersion; may be NULL). */
-film_sample field_shared_sample(const camera *c, int k, double colour[3]);
+   samples (sample_pattern_wavelength), and *band (when not NULL) gets its band, 0 without. */
+film_sample field_shared_sample(const camera *c, int k, uint32_t *band);
 
 /* The render size for a crop of w x h: the smallest 2^a - 1 >= w, 2^b - 1 >= h, so that UVs
    are short binary fractions. */

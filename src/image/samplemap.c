@@ -131,45 +131,51 @@ static void one_line(char *dst, size_t size, const char *src, size_t src_size)
 }
 
 /* The header text without its padding; returns its length, or -1 when it does not fit. */
-static int format_header(const samplemap_header *h, char *buf, size_t size)
+static int format_header(const samplemap_header *h, const char *magic, const char *more,
+                         char *buf, size_t size)
 {
     char lens[sizeof h->lens], pupil[sizeof h->pupil], trace[sizeof h->trace],
-        weighting[sizeof h->weighting];
+        weighting[sizeof h->weighting], bands[32] = "";
     one_line(lens, sizeof lens, h->lens, sizeof h->lens);
     one_line(pupil, sizeof pupil, h->pupil, sizeof h->pupil);
     one_line(trace, sizeof trace, h->trace, sizeof h->trace);
     one_line(weighting, sizeof weighting, h->weighting, sizeof h->weighting);
+    if (h->wavelength_bands > 0)
+        snprintf(bands, sizeof bands, "wavelength_bands %d\n", h->wavelength_bands);
     const int n = snprintf(buf, size,
         "%s\nfilm_width %d\nfilm_height %d\nspp %d\ncrop_x0 %d\ncrop_y0 %d\ncrop_x1 %d\n"
         "crop_y1 %d\npacked_width %d\nfaces %lld\nchunk_faces %lld\nlens %s\npupil %s\n"
         "trace %s\nweighting %s\nf_number %.17g\naperture_diameter_mm %.17g\n"
         "focus_distance_units %.17g\nfilm_distance_mm %.17g\nfilm_diagonal_mm %.17g\n"
-        "unit_mm %.17g\nend\n",
-        MAGIC, h->film_width, h->film_height, h->spp, h->crop_x0, h->crop_y0, h->crop_x1,
+        "unit_mm %.17g\n%s%send\n",
+        magic, h->film_width, h->film_height, h->spp, h->crop_x0, h->crop_y0, h->crop_x1,
         h->crop_y1, h->packed_width, h->faces, h->chunk_faces, lens, pupil, trace, weighting,
         h->f_number, h->aperture_diameter_mm, h->focus_distance_units, h->film_distance_mm,
-        h->film_diagonal_mm, h->unit_mm);
-    if (n < 0 || (size_t)n >= size)
+        h->film_diagonal_mm, h->unit_mm, bands, more);
+    return n >= 0 && (size_t)n < size ? n : -1;
+}
+
+int samplemap_header_text(const samplemap_header *h, const char *magic, const char *more,
+                          char text[SAMPLEMAP_HEADER_BYTES])
+{
+    char buf[SAMPLEMAP_HEADER_BYTES + 1];
+    const int n = format_header(h, magic, more, buf, sizeof buf);
+    if (n < 0)
         return -1;
-    if (h->wavelength_bands <= 0)
-        return n;
-    /* "wavelength_bands N" goes before "end". */
-    const int m = snprintf(buf + n - 4, size - (size_t)n + 4, "wavelength_bands %d\nend\n",
-                           h->wavelength_bands);
-    return m >= 0 && (size_t)(n - 4 + m) < size ? n - 4 + m : -1;
+    memcpy(text, buf, (size_t)n);
+    memset(text + n, ' ', SAMPLEMAP_HEADER_BYTES - (size_t)n);
+    return 0;
 }
 
 int samplemap_finish(FILE *fp, const samplemap_header *h)
 {
-    char text[SAMPLEMAP_HEADER_BYTES + 1];
-    const int n = format_header(h, text, sizeof text);
-    if (n < 0 || h->faces < 0 || fflush(fp) != 0)
+    char text[SAMPLEMAP_HEADER_BYTES];
+    if (samplemap_header_text(h, MAGIC, "", text) != 0 || h->faces < 0 || fflush(fp) != 0)
         return L2P_FAILED;
     /* The records written so far must be exactly the faces the header announces. */
     const off_t end = ftello(fp);
     if (end != (off_t)(SAMPLEMAP_HEADER_BYTES + record_bytes(h) * h->faces))
         return L2P_FAILED;
-    memset(text + n, ' ', SAMPLEMAP_HEADER_BYTES - (size_t)n);
     if (fseeko(fp, 0, SEEK_SET) != 0 || fwrite(text, 1, SAMPLEMAP_HEADER_BYTES, fp) !=
                                             SAMPLEMAP_HEADER_BYTES)
         return L2P_FAILED;
@@ -274,8 +280,8 @@ static int check_all_seen(const int *seen, const char *path, l2p_error *err)
     return L2P_OK;
 }
 
-/* text holds SAMPLEMAP_HEADER_BYTES bytes plus a NUL. */
-static int parse_header(char *text, samplemap_header *h, const char *path, l2p_error *err)
+int samplemap_header_parse(char *text, const char *magic, samplemap_header *h, const char *path,
+                           l2p_error *err)
 {
     const char *text_end = text + SAMPLEMAP_HEADER_BYTES;
     if (memchr(text, '\0', SAMPLEMAP_HEADER_BYTES))
@@ -286,9 +292,10 @@ static int parse_header(char *text, samplemap_header *h, const char *path, l2p_e
         if (!nl)
             return l2p_fail(err, L2P_BAD_INPUT, path, 0, "header has no line 'end'");
         *nl = '\0';
-        if (number == 0 && strcmp(line, MAGIC) != 0)
+        if (number == 0 && strcmp(line, magic) != 0)
             return l2p_fail(err, L2P_BAD_INPUT, path, 1,
-                            "not a lens2pov sample map (first line is not '%s')", MAGIC);
+                            "not a lens2pov %s (first line is not '%s')",
+                            strcmp(magic, MAGIC) ? "field map" : "sample map", magic);
         if (number > 0 && strcmp(line, "end") == 0) {
             int st = check_padding(nl + 1, text_end, path, err);
             return st ? st : check_all_seen(seen, path, err);
@@ -409,7 +416,7 @@ static int read_header(FILE *fp, samplemap_header *h, const char *path, l2p_erro
                         SAMPLEMAP_HEADER_BYTES);
     text[SAMPLEMAP_HEADER_BYTES] = '\0';
     memset(h, 0, sizeof *h);
-    int s = parse_header(text, h, path, err);
+    int s = samplemap_header_parse(text, MAGIC, h, path, err);
     if (!s)
         s = check_film(h, path, err);
     return s ? s : check_layout(h, (long long)st.st_size, path, err);

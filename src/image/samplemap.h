@@ -76,6 +76,16 @@ int samplemap_append(FILE *fp, const samplemap_record *records, const uint32_t *
 int samplemap_finish(FILE *fp, const samplemap_header *h);
 
 int samplemap_read(const char *path, samplemap *out, l2p_error *err);
+
+/* The header on its own, for the field map (fieldmap.h) too, which has another first line and
+   lines of its own. text: the first line magic, a line for every field of h, the lines of
+   `more` ("key value\n" each, or ""), "end", then spaces to SAMPLEMAP_HEADER_BYTES; -1 when
+   it does not fit. Parsing: text is SAMPLEMAP_HEADER_BYTES bytes and a NUL, changed in place;
+   keys it does not know are skipped; L2P_BAD_INPUT naming path as samplemap_read does. */
+int samplemap_header_text(const samplemap_header *h, const char *magic, const char *more,
+                          char text[SAMPLEMAP_HEADER_BYTES]);
+int samplemap_header_parse(char *text, const char *magic, samplemap_header *h, const char *path,
+                           l2p_error *err);
 void samplemap_free(samplemap *m);
 
 #endif

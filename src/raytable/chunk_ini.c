@@ -7,8 +7,7 @@
 #include <unistd.h>
 #include "povray/povray.h"
 
-/* path made absolute in the current folder (malloc'd); as it is when it cannot be. */
-static char *absolute(const char *path)
+char *chunk_ini_absolute(const char *path)
 {
     char cwd[4096];
     if (path[0] == '/' || !getcwd(cwd, sizeof cwd))
@@ -27,7 +26,7 @@ static int ini_cannot_carry(const char *path, l2p_error *err)
 
 int chunk_ini_check_prefix(const char *prefix, l2p_error *err)
 {
-    char *abs = absolute(prefix);
+    char *abs = chunk_ini_absolute(prefix);
     if (!abs)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     const int st = povray_ini_can_carry(abs) ? L2P_OK : ini_cannot_carry(abs, err);
@@ -38,7 +37,7 @@ int chunk_ini_check_prefix(const char *prefix, l2p_error *err)
 int chunk_ini_write(outfile *ini, const char *ini_path, const char *exr_path, int width,
                     long long height, l2p_error *err)
 {
-    char *exr = absolute(exr_path);
+    char *exr = chunk_ini_absolute(exr_path);
     int st = !exr ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
              : !povray_ini_can_carry(exr) ? ini_cannot_carry(exr, err)
                                           : outfile_open(ini, ini_path, err);

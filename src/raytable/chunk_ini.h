@@ -6,6 +6,10 @@
 #include "base/error.h"
 #include "base/outfile.h"
 
+/* path made absolute in the current folder (malloc'd); as it is when it cannot be. POV-Ray
+   resolves an .ini's file names against its own folder, not the .ini's. */
+char *chunk_ini_absolute(const char *path);
+
 /* Checks, before any work, that the .ini files of the table at prefix can name its renders
    (absolute paths; povray_ini_can_carry): L2P_BAD_INPUT naming the path otherwise. */
 int chunk_ini_check_prefix(const char *prefix, l2p_error *err);
