@@ -3,12 +3,14 @@
    table is also printed on stdout, the chart renamed into place when complete. */
 #include "cli/commands.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 #include "base/cleanup.h"
 #include "base/outfile.h"
+#include "base/tempdir.h"
 #include "cli/framing.h"
 #include "draw/plot.h"
 
@@ -21,7 +23,7 @@ typedef struct plot_job {
     camera cams[MAX_CAMERAS];
     const camera *cam_ptr[MAX_CAMERAS];
     int count;
-    char dir[64];      /* the temporary folder; empty until made */
+    char dir[4096];    /* the temporary folder; empty until made */
     char labels[MAX_CAMERAS][32];
 } plot_job;
 
@@ -52,7 +54,7 @@ static int load_cameras(const cli *c, bool vignetting, plot_job *j, l2p_error *e
 
 static char *path_in(const plot_job *j, const char *name)
 {
-    static char path[2][128];
+    static char path[2][4096 + 64];
     static int turn;
     turn ^= 1;
     snprintf(path[turn], sizeof path[turn], "%s/%s", j->dir, name);
@@ -98,10 +100,11 @@ static void title_of(const camera *cam, const char *what, char *title, size_t si
 
 static int draw(const cli *c, plot_job *j, bool vignetting, l2p_error *err)
 {
-    strcpy(j->dir, "/tmp/lens2pov-plot.XXXXXX");
+    snprintf(j->dir, sizeof j->dir, "%s/lens2pov-plot.XXXXXX", temp_root());
     if (!mkdtemp(j->dir)) {
         j->dir[0] = '\0';
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot make a temporary folder in /tmp");
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot make a temporary folder in %s: %s",
+                        temp_root(), strerror(errno));
     }
     cleanup_track(j->dir);
     char title[256];

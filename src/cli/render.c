@@ -22,15 +22,10 @@
 #include "povray/povargs.h"
 #include "povray/povray.h"
 #include "raytable/chunk_name.h"
+#include "base/tempdir.h"
 #include "cli/sizecheck.h"
 #include "field/field_render.h"
 #include "raytable/raytable.h"
-
-static const char *temp_root(void)
-{
-    const char *tmp = getenv("TMPDIR");
-    return tmp && *tmp ? tmp : "/tmp";
-}
 
 /* POV-Ray is given the workspace's files by name (the chunks' .ini and renders), so the
    workspace (--keep-temp, else under $TMPDIR) must have a name it reads as it is. */

@@ -16,6 +16,7 @@
 #include <unistd.h>
 #include "base/cleanup.h"
 #include "base/outfile.h"
+#include "base/tempdir.h"
 #include "povray/povray_log.h"
 
 /* The whole file, NUL-terminated (malloc'd); *n its length. */
@@ -246,9 +247,8 @@ int scene_frames_read(const char *scene, int width, int height, char *const *arg
     memset(out, 0, sizeof *out);
     if (access(scene, R_OK) != 0)
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
-    const char *tmp = getenv("TMPDIR");
     char work[4096];
-    snprintf(work, sizeof work, "%s/lens2pov-camera.XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    snprintf(work, sizeof work, "%s/lens2pov-camera.XXXXXX", temp_root());
     if (!plain_path(work))
         snprintf(work, sizeof work, "/tmp/lens2pov-camera.XXXXXX");
     if (!mkdtemp(work))
