@@ -760,6 +760,16 @@ Test(image_io, grey_file_read_as_rgba)
 
 /* ---- dispersion: bands in the map, colour in developing ---- */
 
+static void write_band_map(const char *path, const samplemap *m, const uint32_t *band)
+{
+    FILE *fp = fopen(path, "wb");
+    cr_assert_not_null(fp);
+    cr_assert_eq(samplemap_begin(fp), L2P_OK);
+    cr_assert_eq(samplemap_append(fp, m->records, band, FACES), L2P_OK);
+    cr_assert_eq(samplemap_finish(fp, &m->header), L2P_OK);
+    cr_assert_eq(fclose(fp), 0);
+}
+
 /* With wavelength bands every record carries one (4 bytes more), the header says how many,
    and they come back as written; a band outside them, or a band count other than spp, is
    refused. */
@@ -773,11 +783,7 @@ Test(samplemap, bands_round_trip_and_are_checked)
     for (int k = 0; k < FACES; k++)
         band[k] = (uint32_t)(k % m.header.spp);
     const char *path = tmp_path(dir, "bands.map");
-    FILE *fp = fopen(path, "wb");
-    cr_assert_eq(samplemap_begin(fp), L2P_OK);
-    cr_assert_eq(samplemap_append(fp, m.records, band, FACES), L2P_OK);
-    cr_assert_eq(samplemap_finish(fp, &m.header), L2P_OK);
-    fclose(fp);
+    write_band_map(path, &m, band);
     struct stat st;
     cr_assert_eq(stat(path, &st), 0);
     cr_assert_eq(st.st_size, SAMPLEMAP_HEADER_BYTES + 20 * FACES);
@@ -791,21 +797,13 @@ Test(samplemap, bands_round_trip_and_are_checked)
     samplemap_free(&r);
 
     band[FACES - 1] = (uint32_t)m.header.spp;   /* one past the last band */
-    fp = fopen(path, "wb");
-    samplemap_begin(fp);
-    samplemap_append(fp, m.records, band, FACES);
-    samplemap_finish(fp, &m.header);
-    fclose(fp);
+    write_band_map(path, &m, band);
     cr_assert_eq(samplemap_read(path, &r, &err), L2P_BAD_INPUT);
     cr_assert(strstr(err.text, "band"), "%s", err.text);
 
     m.header.wavelength_bands = m.header.spp + 1;
     band[FACES - 1] = 0;
-    fp = fopen(path, "wb");
-    samplemap_begin(fp);
-    samplemap_append(fp, m.records, band, FACES);
-    samplemap_finish(fp, &m.header);
-    fclose(fp);
+    write_band_map(path, &m, band);
     cr_assert_eq(samplemap_read(path, &r, &err), L2P_BAD_INPUT);
     cr_assert(strstr(err.text, "wavelength_bands"), "%s", err.text);
     samplemap_free(&m);

@@ -218,21 +218,35 @@ static double cauchy_index(double nd, double vd, double nm)
     return nd + b * (1 / (nm * nm) - 1 / (587.5618 * 587.5618));
 }
 
-/* Effective focal length by a paraxial y-nu trace (Smith, Modern Optical Engineering, ch. 3) of
-   a ray parallel to the axis at height 1: after each surface n'u' = nu - y (n' - n) c, and
-   y grows by t u' to the next; f = -1 / u'_last. */
-static double paraxial_efl_mm(const lens *l, double nm)
+/* A paraxial y-nu trace (Smith, Modern Optical Engineering, ch. 3) of the ray at height y
+   and angle u in front of the lens, with the indices at nm, to film_mm behind the rear
+   vertex: after each surface n'u' = nu - y (n' - n) c, and y grows by t u' to the next.
+   Returns the height on the film; *at_stop (when not NULL) gets the height at the stop and
+   *u_out the angle behind the lens. */
+static double paraxial_trace(const lens *l, double nm, double y, double u, double film_mm,
+                             double *at_stop, double *u_out)
 {
-    double y = 1.0, nu = 0.0, n = 1.0;
+    double nu = u, n = 1.0;
     for (int i = 0; i < l->count; i++) {
         const lens_surface *s = &l->surface[i];
         const double n2 = cauchy_index(s->ior, s->abbe, nm);
+        if (i == l->stop && at_stop)
+            *at_stop = y;
         nu -= y * (n2 - n) * s->curvature_per_mm;
         n = n2;
-        if (i + 1 < l->count)
-            y += s->thickness_mm * nu / n;
+        y += (i + 1 < l->count ? s->thickness_mm : film_mm) * nu / n;
     }
-    return -1.0 / nu;
+    if (u_out)
+        *u_out = nu;
+    return y;
+}
+
+/* The focal length: a ray parallel to the axis at height 1 leaves at angle u', f = -1 / u'. */
+static double paraxial_efl_mm(const lens *l, double nm)
+{
+    double u;
+    paraxial_trace(l, nm, 1.0, 0.0, 0.0, NULL, &u);
+    return -1.0 / u;
 }
 
 static double info_efl_mm(const char *lens_name, double nm)
@@ -331,19 +345,8 @@ Test(dispersion, every_passing_ray_at_every_wavelength_lies_in_the_pupil, .timeo
 static double paraxial_chief_height_mm(const lens *l, double nm, double tan_theta, double film_mm)
 {
     double at_stop[2], on_film[2];
-    for (int k = 0; k < 2; k++) {
-        double y = k, nu = tan_theta, n = 1.0;
-        for (int i = 0; i < l->count; i++) {
-            const lens_surface *s = &l->surface[i];
-            const double n2 = cauchy_index(s->ior, s->abbe, nm);
-            if (i == l->stop)
-                at_stop[k] = y;
-            nu -= y * (n2 - n) * s->curvature_per_mm;
-            n = n2;
-            y += (i + 1 < l->count ? s->thickness_mm : film_mm) * nu / n;
-        }
-        on_film[k] = y;
-    }
+    for (int k = 0; k < 2; k++)
+        on_film[k] = paraxial_trace(l, nm, k, tan_theta, film_mm, &at_stop[k], NULL);
     const double y0 = -at_stop[0] / (at_stop[1] - at_stop[0]);
     return on_film[0] + y0 * (on_film[1] - on_film[0]);
 }
@@ -388,22 +391,13 @@ static void channel_centroids(const char *path, double sum[3], double x[3])
 }
 
 /* The film distance (behind the rear vertex) where a paraxial ray parallel to the axis
-   crosses it at this wavelength: the heights at two film distances are linear in it. */
+   crosses it at this wavelength: at height y0 on the rear vertex's plane with angle u', it
+   crosses at -y0 / u'. */
 static double paraxial_focus_mm(const lens *l, double nm)
 {
-    double y[2];
-    for (int k = 0; k < 2; k++) {
-        double height = 1.0, nu = 0.0, n = 1.0;
-        for (int i = 0; i < l->count; i++) {
-            const lens_surface *s = &l->surface[i];
-            const double n2 = cauchy_index(s->ior, s->abbe, nm);
-            nu -= height * (n2 - n) * s->curvature_per_mm;
-            n = n2;
-            height += (i + 1 < l->count ? s->thickness_mm : 100.0 * k) * nu / n;
-        }
-        y[k] = height;
-    }
-    return -100.0 * y[0] / (y[1] - y[0]);
+    double u;
+    const double y0 = paraxial_trace(l, nm, 1.0, 0.0, 0.0, NULL, &u);
+    return -y0 / u;
 }
 
 /* Lateral colour: a white disk at infinity, 10 degrees off the axis, rendered through the
