@@ -364,3 +364,47 @@ Test(povray, a_failure_stops_the_other_processes)
     remove_tree(dir);
     free(dir);
 }
+
+/* POV-Ray's "Timed out waiting for worker thread startup" (a loaded machine) is passing: the
+   chunk is started again, at most twice. A stand-in that fails so once renders the second
+   time; one that always does fails the render with POV-Ray's message after three starts. */
+Test(povray, a_thread_startup_timeout_is_retried)
+{
+    for (int always = 0; always < 2; always++) {
+        char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
+        char *script = fmt("%s/%s", dir, "slowpov"), *count = fmt("%s/%s", dir, "starts");
+        write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                        "plane { -z, 0 pigment { rgb <1,0,0> } finish { ambient 1 diffuse 0 } }\n");
+        char *text = fmt(always ? "#!/bin/sh\necho x >> '%s'\n"
+                                  "echo 'Timed out waiting for worker thread startup' >&2; exit 1\n%s"
+                                : "#!/bin/sh\necho x >> '%s'\n"
+                                  "if [ $(wc -l < '%s') -lt 2 ]; then\n"
+                                  "  echo 'Timed out waiting for worker thread startup' >&2; exit 1\nfi\n"
+                                  "exec povray \"$@\"\n", count, always ? "" : count);
+        write_text(script, text);
+        free(text);
+        chmod(script, 0755);
+        fixture fx;
+        make_chunks(&fx, dir, 1, (const int[]){1});
+        povray_options o = options(scene, dir, 1);
+        o.povray = script;
+        l2p_error err = {0};
+        const int st = povray_render_chunks(fx.chunk, 1, &o, &err);
+        char *starts = read_text(count, NULL);
+        const int n = starts ? (int)(strlen(starts) / 2) : 0;
+        if (always) {
+            cr_expect_eq(st, L2P_FAILED);
+            cr_expect(strstr(err.text, "Timed out"), "%s", err.text);
+            cr_expect_eq(n, 3, "started %d times", n);
+        } else {
+            cr_expect_eq(st, L2P_OK, "%s", err.text);
+            cr_expect_eq(n, 2, "started %d times", n);
+            expect_uniform(fx.chunk[0].output_exr, 1, 0, 0);
+        }
+        free(starts);
+        free_fixture(&fx);
+        free(scene), free(script), free(count);
+        remove_tree(dir);
+        free(dir);
+    }
+}

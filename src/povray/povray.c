@@ -26,7 +26,8 @@
 enum {
     TICK_MS = 20,
     DRAW_EVERY_TICKS = 12,     /* redraw the bar 4 times a second */
-    STOP_WAIT_TICKS = 250      /* SIGTERM, then 5 s, then SIGKILL */
+    STOP_WAIT_TICKS = 250,     /* SIGTERM, then 5 s, then SIGKILL */
+    TRANSIENT_RETRIES = 2      /* starts again of a chunk that failed for a passing cause */
 };
 
 /* ---------------------------------------------------------------- the run's shared state */
@@ -36,6 +37,7 @@ typedef struct job {
     int chunk;
     char *log_path;
     double parse_fraction, render_fraction;
+    int retries;               /* times this chunk was started again (retried) */
 } job;
 
 typedef struct run {
@@ -408,6 +410,21 @@ static void draw_progress(run *r, int finished)
 
 /* ---------------------------------------------------------------- the scheduler */
 
+/* A run that failed for a passing cause (povray_log_transient) is started again, at most
+   TRANSIENT_RETRIES times a chunk, with a warning. Returns whether it was. */
+static bool retried(run *r, job *j, int status, int *st, l2p_error *err)
+{
+    if (*st || (WIFEXITED(status) && WEXITSTATUS(status) == 0) || j->retries >= TRANSIENT_RETRIES ||
+        !povray_log_transient(j->log_path))
+        return false;
+    fprintf(stderr, "lens2pov: warning: POV-Ray timed out starting its threads on chunk %d (a "
+                    "loaded machine); starting it again\n", j->chunk);
+    const int retries = j->retries + 1;
+    *st = start_job(r, j, j->chunk, err);
+    j->retries = retries;
+    return true;
+}
+
 /* Reaps the jobs that ended; returns how many did, and the first failure in *st. */
 static int reap_jobs(run *r, int *st, l2p_error *err)
 {
@@ -419,7 +436,10 @@ static int reap_jobs(run *r, int *st, l2p_error *err)
             continue;
         cleanup_untrack_child(j->pid);
         j->pid = 0;
+        if (retried(r, j, status, st, err))
+            continue;
         ended++;
+        j->retries = 0;
         if (!*st)
             *st = check_finished(r, j, status, err);
     }

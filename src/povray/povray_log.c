@@ -228,3 +228,13 @@ void povray_log_progress(const char *log_path, long long faces, double *parse, d
     free(tail);
 }
 
+
+/* POV-Ray 3.7 gives up on a render whose worker threads do not report in within its time
+   limit, which a loaded machine can exceed; the same run succeeds when started again. */
+bool povray_log_transient(const char *log_path)
+{
+    char *tail = read_tail(log_path, ERROR_TAIL);
+    const bool transient = tail && strstr(tail, "Timed out waiting for worker thread startup");
+    free(tail);
+    return transient;
+}

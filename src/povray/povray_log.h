@@ -2,6 +2,7 @@
 #ifndef LENS2POV_POVRAY_LOG_H
 #define LENS2POV_POVRAY_LOG_H
 
+#include <stdbool.h>
 #include "base/error.h"
 
 typedef struct povray_path_link {
@@ -25,5 +26,9 @@ int povray_log_error(const char *log_path, const povray_log_names *names, l2p_er
 /* The latest progress in the log: the parse (estimated from the chunk's face count) and the
    render, each in [0, 1]; left as they were when the log says nothing new. */
 void povray_log_progress(const char *log_path, long long faces, double *parse, double *render);
+
+/* Whether a failed run's log says it failed for a passing cause (its threads were slow to
+   start on a loaded machine): the run may be started again. */
+bool povray_log_transient(const char *log_path);
 
 #endif
