@@ -676,8 +676,9 @@ Test(robustness, render_killed_outright_leaves_no_povray_and_its_workspace_goes_
 }
 
 /* Every output is checked before any work: a missing folder, a folder where a file is
-   expected. Exit 2 with a message naming the path, in well under a second (the render asked
-   for would take many), and nothing written. */
+   expected. Exit 2 with a message naming the path, nothing written, and before the tracing:
+   the 79 M samples asked for take far longer to trace and write, so a bound of 10 s leaves
+   room for a sanitizer build on a loaded machine (2 s seen) and still tells the two apart. */
 Test(robustness, bad_output_paths_are_refused_before_any_work)
 {
     const char *dir = test_tmpdir();
@@ -721,7 +722,7 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
         const double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
         cr_expect_eq(st, 2, "case %zu: exit %d: %s", i, st, errtext);
         cr_expect(errtext && strstr(errtext, cases[i].named), "case %zu: %s", i, errtext);
-        cr_expect_lt(seconds, 1.0, "case %zu took %.2f s", i, seconds);
+        cr_expect_lt(seconds, 10.0, "case %zu took %.2f s", i, seconds);
         free(errtext);
         const char *const allowed[] = {"scene.pov", "sub", "dir.png", NULL};
         const char *first;
@@ -910,7 +911,7 @@ Test(robustness, requests_that_cannot_fit_are_refused_before_tracing)
         cr_expect_eq(st, 2, "case %zu: exit %d: %s", i, st, errtext);
         cr_expect(errtext && strstr(errtext, "--no-size-check") && strstr(errtext, "B of "),
                   "case %zu: %s", i, errtext);
-        cr_expect_lt(seconds, 1.0, "case %zu took %.2f s", i, seconds);
+        cr_expect_lt(seconds, 10.0, "case %zu took %.2f s", i, seconds);
         free(errtext);
         const char *const allowed[] = {"scene.pov", NULL};
         const char *first;
