@@ -414,3 +414,11 @@ marker_centroid image_marker(const char *path, int c)
     free(p);
     return (marker_centroid){s > 0 ? sx / s : NAN, s > 0 ? sy / s : NAN, s > 0};
 }
+
+int system_povray(const char *command)
+{
+    int status = -1;
+    for (int tries = 0; tries < 3 && status != 0; tries++)
+        status = system(command);
+    return status;
+}

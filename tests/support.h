@@ -22,6 +22,11 @@ void run_lens2pov_ok(const char *what, ...);
 /* The same with the arguments in a NULL-terminated array. */
 int run_lens2pov_argv(char **out, char **errout, char *const args[]);
 
+/* Runs a shell command that runs POV-Ray (system()), up to three times while it fails: POV-Ray
+   3.7 sometimes times out starting its threads on a loaded machine, and lens2pov's runner
+   starts such a run again too (docs/povray.md). Returns the last status. */
+int system_povray(const char *command);
+
 /* A fresh folder under /tmp, removed with everything in it when the test's process exits
    (the name is in a buffer the next call reuses), and a path inside a folder (static buffers
    rotate). */

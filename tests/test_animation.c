@@ -45,7 +45,7 @@ Test(animation, frames_named_as_povray_traced_once)
     char cmd[1024];
     snprintf(cmd, sizeof cmd, "cd '%s' && povray +Iscene.pov +Oown.png +W48 +H36 +FN -A -D -V "
              "-GA +KFI1 +KFF3 >povray.log 2>&1", dir);
-    cr_assert_eq(system(cmd), 0, "%s", cmd);
+    cr_assert_eq(system_povray(cmd), 0, "%s", cmd);
     char *errtext = NULL;
     const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--angle", "scene",
                        "--jobs", "2", "-q", "--keep-temp", keep, "-o", tmp_path(dir, "lens.png"),

@@ -51,7 +51,7 @@ static int by_hand(const char *dir, const char *lens, const char *out)
         fprintf(f, "#include \"%s/scene.pov\"\n#include \"%s\"\n", dir, inc);
         fclose(f);
         snprintf(cmd, sizeof cmd, "povray '%s' +I'%s' -V -GA >/dev/null 2>&1", ini, wrapper);
-        cr_assert_eq(system(cmd), 0, "POV-Ray on %s", ini);
+        cr_assert_eq(system_povray(cmd), 0, "POV-Ray on %s", ini);
     }
     cr_assert(renders > 0, "trace wrote no render's ini");
     errtext = NULL;

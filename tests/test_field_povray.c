@@ -68,7 +68,7 @@ Test(field_povray, the_model_gives_the_rays_povray_traces)
     snprintf(cmd, sizeof cmd,
              "cd '%s' && povray +Iscene.pov +Oout.exr +FE +W%d +H%d +SR2 +EC%d -A -D -P -UA -GS -GR "
              "-V +WT1 >povray.log 2>&1", dir, W + 1, H + 1, W);
-    cr_assert_eq(system(cmd), 0, "povray failed, see %s/povray.log", dir);
+    cr_assert_eq(system_povray(cmd), 0, "povray failed, see %s/povray.log", dir);
 
     int iw, ih;
     float *px;
@@ -170,7 +170,7 @@ Test(field_povray, povray_renders_a_lens_field_within_the_tolerance)
     snprintf(cmd, sizeof cmd,
              "cd '%s' && povray +Iscene.pov +Oout.exr +FE +W%d +H%d +SR2 +EC%d -A -D -P -UA -GS -GR "
              "-V +WT1 >povray.log 2>&1", dir, rw + 1, rh + 1, rw);
-    cr_assert_eq(system(cmd), 0, "povray failed, see %s/povray.log", dir);
+    cr_assert_eq(system_povray(cmd), 0, "povray failed, see %s/povray.log", dir);
     int iw, ih;
     float *px;
     cr_assert_eq(image_read_rgba(tmp_path(dir, "out.exr"), &iw, &ih, &px, &err), 0, "%s", err.text);

@@ -75,7 +75,7 @@ static void run_povray(const char *dir, const char *scene, const char *out, int 
     snprintf(cmd, sizeof cmd,
              "cd '%s' && povray +I%s +O%s +W%d +H%d -A -D -V -GA %s >povray.log 2>&1", dir,
              scene, out, w, h, extra);
-    const int st = system(cmd);
+    const int st = system_povray(cmd);
     PATH(log_path, dir, "povray.log");
     char *log = read_text(log_path, NULL);
     cr_assert_eq(st, 0, "%s failed:\n%s", cmd, log ? log : "(no log)");

@@ -37,7 +37,7 @@ static void povray_render(const char *dir, const char *scene, const char *out)
     snprintf(cmd, sizeof cmd,
              "cd '%s' && povray +I%s +O%s +W64 +H48 +FN -A -D -V -GA >povray.log 2>&1", dir,
              scene, out);
-    cr_assert_eq(system(cmd), 0, "%s", cmd);
+    cr_assert_eq(system_povray(cmd), 0, "%s", cmd);
 }
 
 /* The scene through the lens, with no placement and --angle scene, against POV-Ray's camera. */
