@@ -1,6 +1,6 @@
 #!/bin/sh
 # make valgrind: lens2pov under valgrind's memcheck on small runs: info, a trace (with the
-# CSV), a refused lens (the error path), develop of a file that is not an image and a whole
+# CSV), traces with dispersion (pixel and field sampling), a refused lens (the error path), develop of a file that is not an image and a whole
 # render (trace, POV-Ray runner, develop); VALGRIND_ALL=1 adds info with a camera, a thick
 # trace, a refused option and develop of a real render (develop and render cost some 10 s
 # each: valgrind reads the OpenImageIO libraries that they alone load). Fails (exit 1) on any
@@ -77,6 +77,11 @@ run 0 "trace 32x24x4 --rays" trace "$lens" --width 32 --height 24 --spp 4 --look
     --rays "$work/t.csv" -o "$work/t" --quiet
 [ "$all" = 1 ] && run 0 "trace --trace thick --pupil rear" trace "$lens" --width 16 --height 12 --spp 2 \
     --trace thick --pupil rear -o "$work/k" --quiet
+run 0 "trace with dispersion, 16x12x4 --rays" trace "$(dirname "$lens")/cooke-triplet.50mm.dat" \
+    --width 16 --height 12 --spp 4 --rays "$work/d.csv" -o "$work/d" --quiet
+run 0 "trace --sampling field with dispersion, 24x18x3" trace \
+    "$(dirname "$lens")/cooke-triplet.50mm.dat" --width 24 --height 18 --spp 3 --sampling field \
+    -o "$work/f" --quiet
 printf '50 5 1.5 20\n0 5 0 10\n-50 0 1\n' >"$work/bad.dat"
 run 2 "trace of a malformed lens" trace "$work/bad.dat" -o "$work/b" --quiet
 [ "$all" = 1 ] && run 2 "trace with a bad option" trace "$lens" --aperture-diameter 99 -o "$work/b" --quiet
