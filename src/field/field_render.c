@@ -1,5 +1,6 @@
 /* render --sampling field: sub-images built on worker threads, packed into POV-Ray renders of
-   at most FIELD_FACES_PER_RENDER faces, rendered by the chunk runner, developed here. */
+   at most FIELD_FACES_PER_RENDER faces, rendered by the chunk runner as one animation a job,
+   developed here. */
 #include "field/field_render.h"
 
 #include <pthread.h>
@@ -144,30 +145,37 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
 }
 
 /* Groups consecutive sub-images into renders: as many as the face budget takes, at most
-   most_per_render (so that every POV-Ray job gets a share), choosing the count and grid whose
-   render wastes the fewest pixels (its sides are 2^a - 1: every UV a short binary fraction).
-   Returns the number of renders. */
+   most_per_render (so that every POV-Ray job gets a share). The first render takes the count
+   and grid whose render wastes the fewest pixels (its sides are 2^a - 1: every UV a short
+   binary fraction); every later one has its grid and size, with as many sub-images as the
+   budget and the grid take, since a POV-Ray process renders all its renders at one size
+   (assign_jobs). Returns the number of renders. */
 static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_plan *plans)
 {
-    int renders = 0;
+    int renders = 0, grid_n = 1, grid_nx = 1;
     for (int first = 0; first < spp; renders++) {
         double best = INFINITY;
         int best_n = 1, best_nx = 1;
         long long faces = 0;
         for (int n = 1; first + n <= spp; n++) {
             faces += subs[first + n - 1].stats.faces;
-            if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render))
+            if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render ||
+                          (renders > 0 && n > grid_n)))
                 break;
-            for (int nx = 1; nx <= n; nx++) {
+            for (int nx = 1; nx <= n && renders == 0; nx++) {
                 int rw, rh;
                 grid_size(n, nx, w, h, &rw, &rh);
                 double cost = (double)(rw + 1) * (rh + 1) / n;
                 if (cost <= best)
                     best = cost, best_n = n, best_nx = nx;
             }
+            if (renders > 0)
+                best_n = n, best_nx = grid_nx;
         }
+        if (renders == 0)
+            grid_n = best_n, grid_nx = best_nx;
         render_plan *p = &plans[renders];
-        grid_size(best_n, best_nx, w, h, &p->width, &p->height);
+        grid_size(grid_n, grid_nx, w, h, &p->width, &p->height);
         p->first = first, p->count = best_n, p->faces = 0;
         for (int i = 0; i < best_n; i++) {
             sub *s = &subs[first + i];
@@ -177,6 +185,45 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_pl
         first += best_n;
     }
     return renders;
+}
+
+/* A POV-Ray process renders its job's renders as the frames of one animation
+   (povray_render_sequences), paying POV-Ray's start-up and exit once a job, not once a
+   render; pack gives them all one size, as a POV-Ray run needs. Renders go, those of the
+   most sub-images first, to the job with the fewest sub-images so far. order gets the renders
+   job by job (in render order within a job), frames each job's count; returns the number of
+   jobs. */
+static int assign_jobs(const render_plan *plans, int renders, int jobs, int *order, int *frames)
+{
+    const int n = jobs < renders ? jobs : renders;
+    int *job_of = malloc(sizeof *job_of * (size_t)renders);
+    long long *load = calloc((size_t)n, sizeof *load);
+    if (!job_of || !load) {
+        free(job_of), free(load);
+        return -1;
+    }
+    for (int r = 0; r < renders; r++)
+        job_of[r] = -1;
+    for (int done = 0; done < renders; done++) {
+        int r = -1, j = 0;
+        for (int i = 0; i < renders; i++)
+            if (job_of[i] < 0 && (r < 0 || plans[i].count > plans[r].count))
+                r = i;
+        for (int i = 1; i < n; i++)
+            if (load[i] < load[j])
+                j = i;
+        job_of[r] = j;
+        load[j] += plans[r].count;
+    }
+    int k = 0;
+    for (int j = 0; j < n; j++) {
+        frames[j] = 0;
+        for (int r = 0; r < renders; r++)
+            if (job_of[r] == j)
+                order[k++] = r, frames[j]++;
+    }
+    free(job_of), free(load);
+    return n;
 }
 
 /* ---------------------------------------------------------------- files */
@@ -287,8 +334,11 @@ static int render_and_develop(const camera *c, const field_render_options *o, su
                               const render_plan *plans, int renders, l2p_error *err)
 {
     const int w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
-    povray_chunk *ch = calloc((size_t)renders, sizeof *ch);
-    int st = ch ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    povray_chunk *ch = calloc((size_t)renders, sizeof *ch), *by_job = calloc((size_t)renders, sizeof *by_job);
+    int *order = calloc((size_t)renders, sizeof *order), *frames = calloc((size_t)renders, sizeof *frames);
+    const int jobs = !ch || !by_job || !order || !frames
+                         ? -1 : assign_jobs(plans, renders, o->jobs > 0 ? o->jobs : 1, order, frames);
+    int st = jobs > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int r = 0; r < renders && !st; r++) {
         ch[r] = (povray_chunk){.include_path = name_of(o->work_dir, r, "inc"),
                                .ini_path = name_of(o->work_dir, r, "ini"),
@@ -304,8 +354,10 @@ static int render_and_develop(const camera *c, const field_render_options *o, su
                                .jobs = o->jobs, .threads_per_job = o->threads_per_job,
                                .show_progress = o->progress, .film_width = c->film.width,
                                .film_height = c->film.height};
+    for (int k = 0; k < renders && !st; k++)
+        by_job[k] = ch[order[k]];
     if (!st)
-        st = povray_render_chunks(ch, renders, &po, err);
+        st = povray_render_sequences(by_job, frames, jobs, &po, err);
     samplemap map = {.records = NULL};
     povmesh_camera_header(c, &map.header);
     const size_t stride = develop_sums_per_pixel(&map.header);
@@ -319,7 +371,7 @@ static int render_and_develop(const camera *c, const field_render_options *o, su
     free(sums);
     for (int r = 0; ch && r < renders; r++)
         free((char *)ch[r].include_path), free((char *)ch[r].ini_path), free((char *)ch[r].output_exr);
-    free(ch);
+    free(ch), free(by_job), free(order), free(frames);
     return st;
 }
 
