@@ -408,3 +408,90 @@ Test(povray, a_thread_startup_timeout_is_retried)
         free(dir);
     }
 }
+
+/* ---------------------------------------------------------------- sequences */
+
+/* A script standing in for POV-Ray that notes each start in dir/starts, then runs it. */
+static char *counting_povray(const char *dir)
+{
+    char *script = fmt("%s/%s", dir, "countpov"), *starts = fmt("%s/%s", dir, "starts");
+    char *text = fmt("#!/bin/sh\necho start >> '%s'\nexec povray \"$@\"\n%s", starts, "");
+    write_text(script, text);
+    chmod(script, 0755);
+    free(text);
+    free(starts);
+    return script;
+}
+
+static int povray_starts(const char *dir)
+{
+    char *starts = fmt("%s/%s", dir, "starts");
+    char *text = read_text(starts, NULL);
+    int n = 0;
+    for (const char *p = text; p && (p = strstr(p, "start")) != NULL; p++)
+        n++;
+    free(text);
+    free(starts);
+    return n;
+}
+
+/* Two chunks, one looking at each plane, as the two frames of one POV-Ray process: each
+   frame's picture is its own chunk's, in its chunk's output_exr, and no frame file is left;
+   a scene reading frame_number and clock sees a still's. */
+Test(povray, a_sequence_renders_its_chunks_as_the_frames_of_one_process)
+{
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                    "#if (frame_number != 0 | clock != 0 | final_frame != 0) #error \"animated\" #end\n"
+                    "plane { -z, 0 pigment { rgb <1,0,0> } finish { ambient 1 diffuse 0 } }\n"
+                    "plane { z, -10 pigment { rgb <0,1,0> } finish { ambient 1 diffuse 0 } }\n");
+    char *script = counting_povray(dir);
+    fixture fx;
+    make_chunks(&fx, dir, 2, (const int[]){1, -1});
+    povray_options o = options(scene, dir, 2);
+    o.povray = script;
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_sequences(fx.chunk, (const int[]){2}, 1, &o, &err), L2P_OK, "%s",
+                 err.text);
+    expect_uniform(fx.chunk[0].output_exr, 1, 0, 0);
+    expect_uniform(fx.chunk[1].output_exr, 0, 1, 0);
+    cr_expect_eq(povray_starts(dir), 1);
+    cr_expect_eq(count_entries(dir, "povray.s000.f", NULL, 0), 0, "frame files left");
+
+    /* one chunk a sequence: a process each, the same pictures */
+    unlink(fx.chunk[0].output_exr), unlink(fx.chunk[1].output_exr);
+    cr_assert_eq(povray_render_sequences(fx.chunk, (const int[]){1, 1}, 2, &o, &err), L2P_OK,
+                 "%s", err.text);
+    expect_uniform(fx.chunk[0].output_exr, 1, 0, 0);
+    expect_uniform(fx.chunk[1].output_exr, 0, 1, 0);
+    cr_expect_eq(povray_starts(dir), 3);
+    free_fixture(&fx);
+    free(scene);
+    free(script);
+    remove_tree(dir);
+    free(dir);
+}
+
+/* A scene that fails only when parsed a second time fails the sequence in its second frame,
+   with POV-Ray's own message for it, not the first frame's warnings. */
+Test(povray, an_error_in_a_later_frame_fails_with_its_message)
+{
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "once.pov");
+    write_text(scene, "#version 3.7;\n"
+                    "#if (file_exists(\"seen.txt\"))\n  #error \"this scene renders once\"\n#end\n"
+                    "#fopen Seen \"seen.txt\" write\n#fclose Seen\n"
+                    "plane { -z, 0 pigment { rgb <1,0,0> } finish { ambient 1 diffuse 0 } }\n");
+    fixture fx;
+    make_chunks(&fx, dir, 2, (const int[]){1, 1});
+    povray_options o = options(scene, dir, 1);
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_sequences(fx.chunk, (const int[]){2}, 1, &o, &err), L2P_FAILED);
+    char *expected = fmt("%s:3: Parse halted by #error directive: this scene renders once%s",
+                         scene, "");
+    cr_expect_str_eq(err.text, expected);
+    free(expected);
+    free_fixture(&fx);
+    free(scene);
+    remove_tree(dir);
+    free(dir);
+}

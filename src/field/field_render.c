@@ -1,6 +1,7 @@
 /* render and trace --sampling field: sub-images built on worker threads, their weights into
    the field map, packed into POV-Ray renders of at most FIELD_FACES_PER_RENDER faces; render
-   runs them through the chunk runner and develops them from the map (field_develop.c). */
+   runs them through the chunk runner, one animation a job, and develops them from the map
+   (field_develop.c). */
 #include "field/field_render.h"
 
 #include <pthread.h>
@@ -123,30 +124,37 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
 }
 
 /* Groups consecutive sub-images into renders: as many as the face budget takes, at most
-   most_per_render (so that every POV-Ray job gets a share), choosing the count and grid whose
-   render wastes the fewest pixels (its sides are 2^a - 1: every UV a short binary fraction).
-   Returns the number of renders. */
+   most_per_render (so that every POV-Ray job gets a share). The first render takes the count
+   and grid whose render wastes the fewest pixels (its sides are 2^a - 1: every UV a short
+   binary fraction); every later one has its grid and size, with as many sub-images as the
+   budget and the grid take, since a POV-Ray process renders all its renders at one size
+   (assign_jobs). Returns the number of renders. */
 static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_plan *plans)
 {
-    int renders = 0;
+    int renders = 0, grid_n = 1, grid_nx = 1;
     for (int first = 0; first < spp; renders++) {
         double best = INFINITY;
         int best_n = 1, best_nx = 1;
         long long faces = 0;
         for (int n = 1; first + n <= spp; n++) {
             faces += subs[first + n - 1].stats.faces;
-            if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render))
+            if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render ||
+                          (renders > 0 && n > grid_n)))
                 break;
-            for (int nx = 1; nx <= n; nx++) {
+            for (int nx = 1; nx <= n && renders == 0; nx++) {
                 int rw, rh;
                 grid_size(n, nx, w, h, &rw, &rh);
                 double cost = (double)(rw + 1) * (rh + 1) / n;
                 if (cost <= best)
                     best = cost, best_n = n, best_nx = nx;
             }
+            if (renders > 0)
+                best_n = n, best_nx = grid_nx;
         }
+        if (renders == 0)
+            grid_n = best_n, grid_nx = best_nx;
         render_plan *p = &plans[renders];
-        grid_size(best_n, best_nx, w, h, &p->width, &p->height);
+        grid_size(grid_n, grid_nx, w, h, &p->width, &p->height);
         p->first = first, p->count = best_n, p->faces = 0;
         for (int i = 0; i < best_n; i++) {
             sub *s = &subs[first + i];
@@ -156,6 +164,45 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_pl
         first += best_n;
     }
     return renders;
+}
+
+/* A POV-Ray process renders its job's renders as the frames of one animation
+   (povray_render_sequences), paying POV-Ray's start-up and exit once a job, not once a
+   render; pack gives them all one size, as a POV-Ray run needs. Renders go, those of the
+   most sub-images first, to the job with the fewest sub-images so far. order gets the renders
+   job by job (in render order within a job), frames each job's count; returns the number of
+   jobs. */
+static int assign_jobs(const render_plan *plans, int renders, int jobs, int *order, int *frames)
+{
+    const int n = jobs < renders ? jobs : renders;
+    int *job_of = malloc(sizeof *job_of * (size_t)renders);
+    long long *load = calloc((size_t)n, sizeof *load);
+    if (!job_of || !load) {
+        free(job_of), free(load);
+        return -1;
+    }
+    for (int r = 0; r < renders; r++)
+        job_of[r] = -1;
+    for (int done = 0; done < renders; done++) {
+        int r = -1, j = 0;
+        for (int i = 0; i < renders; i++)
+            if (job_of[i] < 0 && (r < 0 || plans[i].count > plans[r].count))
+                r = i;
+        for (int i = 1; i < n; i++)
+            if (load[i] < load[j])
+                j = i;
+        job_of[r] = j;
+        load[j] += plans[r].count;
+    }
+    int k = 0;
+    for (int j = 0; j < n; j++) {
+        frames[j] = 0;
+        for (int r = 0; r < renders; r++)
+            if (job_of[r] == j)
+                order[k++] = r, frames[j]++;
+    }
+    free(job_of), free(load);
+    return n;
 }
 
 /* ---------------------------------------------------------------- files */
@@ -260,6 +307,7 @@ typedef struct field_files {
     char *map_path;            /* the map's final path (outfile forgets it once committed) */
     outfile *inc, *ini;
     povray_chunk *chunk;       /* include, ini and picture paths, faces */
+    render_plan *plans;        /* each render's size and sub-images */
     int renders;
 } field_files;
 
@@ -272,7 +320,7 @@ static void files_free(field_files *f)
         free((char *)f->chunk[r].include_path), free((char *)f->chunk[r].ini_path);
         free((char *)f->chunk[r].output_exr);
     }
-    free(f->inc), free(f->ini), free(f->chunk), free(f->map_path);
+    free(f->inc), free(f->ini), free(f->chunk), free(f->map_path), free(f->plans);
     memset(f, 0, sizeof *f);
 }
 
@@ -344,7 +392,7 @@ static int build_files(const camera *c, double tolerance_px, int jobs, const cha
         if (!st && !(st = outfile_open(&out->ini[r], ch->ini_path, err)))
             st = write_ini(&plans[r], ch->output_exr, &out->ini[r], err);
     }
-    free(plans);
+    out->plans = plans;
     return st;
 }
 
@@ -369,6 +417,23 @@ static int develop_from_map(const field_files *f, const char *output, l2p_error 
         st = field_develop(&m, exr, f->renders, output, err);
     free(exr);
     field_map_free(&m);
+    return st;
+}
+
+/* Each POV-Ray job renders its share of the renders as one animation (assign_jobs). */
+static int render_by_jobs(const field_files *f, int jobs, const povray_options *po, l2p_error *err)
+{
+    povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
+    int *order = calloc((size_t)f->renders + 1, sizeof *order);
+    int *frames = calloc((size_t)f->renders + 1, sizeof *frames);
+    const int n = !by_job || !order || !frames
+                      ? -1 : assign_jobs(f->plans, f->renders, jobs > 0 ? jobs : 1, order, frames);
+    int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < f->renders && !st; k++)
+        by_job[k] = f->chunk[order[k]];
+    if (!st)
+        st = povray_render_sequences(by_job, frames, n, po, err);
+    free(by_job), free(order), free(frames);
     return st;
 }
 
@@ -399,7 +464,7 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                .show_progress = o->progress, .film_width = c->film.width,
                                .film_height = c->film.height};
     if (!st)
-        st = povray_render_chunks(f.chunk, f.renders, &po, err);
+        st = render_by_jobs(&f, o->jobs, &po, err);
     if (!st)
         st = develop_from_map(&f, o->output, err);
     files_free(&f);

@@ -34,7 +34,8 @@ enum {
 
 typedef struct job {
     pid_t pid;                 /* 0: slot free */
-    int chunk;
+    int task;                  /* a chunk, or a sequence of them */
+    int frame;                 /* of a sequence: the frame POV-Ray is at (1-based; 0 before) */
     char *log_path;
     double parse_fraction, render_fraction;
     int retries;               /* times this chunk was started again (retried) */
@@ -43,6 +44,11 @@ typedef struct job {
 typedef struct run {
     const povray_chunk *chunks;
     int count;
+    /* What one process renders: a chunk (frames NULL, tasks == count), or sequence t, the
+       frames[t] chunks from first[t] on, as the frames of one animation. */
+    const int *frames;
+    int *first;
+    int tasks;
     const povray_options *opts;
     char *exe;
     char *work_dir;
@@ -73,11 +79,36 @@ static void free_run(run *r)
     for (int i = 0; r->jobs && i < r->job_slots; i++)
         free(r->jobs[i].log_path);
     free(r->jobs);
+    free(r->first);
 }
 
 static int out_of_memory(l2p_error *err)
 {
     return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+}
+
+static int task_first(const run *r, int t)
+{
+    return r->frames ? r->first[t] : t;
+}
+
+static int task_chunks(const run *r, int t)
+{
+    return r->frames ? r->frames[t] : 1;
+}
+
+/* The chunk a job is at: a sequence's current frame (its first before POV-Ray names one). */
+static int job_chunk(const run *r, const job *j)
+{
+    const int k = j->frame > 1 ? j->frame - 1 : 0;
+    return task_first(r, j->task) + (k < task_chunks(r, j->task) ? k : task_chunks(r, j->task) - 1);
+}
+
+/* WORK/povray.cNNN.EXT, chunk NNN's wrapper and log; WORK/povray.sNNN.EXT, sequence NNN's. */
+static char *task_file_name(const run *r, int t, const char *ext)
+{
+    return r->frames ? str_printf("%s.s%03d.%s", r->chunk_prefix, t, ext)
+                     : chunk_file_name(r->chunk_prefix, t, ext);
 }
 
 /* A path POV-Ray can read: abs_path itself, or a symlink named name in work_dir. */
@@ -172,17 +203,24 @@ static int prepare_scene(run *r, l2p_error *err)
     return st;
 }
 
-static int prepare_run(run *r, const povray_chunk *chunks, int count, const povray_options *opts,
-                       l2p_error *err)
+static int prepare_run(run *r, const povray_chunk *chunks, int count, const int *frames,
+                       int tasks, const povray_options *opts, l2p_error *err)
 {
     memset(r, 0, sizeof *r);
     r->chunks = chunks;
     r->count = count;
+    r->frames = frames;
+    r->tasks = tasks;
     r->opts = opts;
     r->job_slots = opts->jobs > 0 ? opts->jobs : 1;
-    if (r->job_slots > count)
-        r->job_slots = count;
+    if (r->job_slots > tasks)
+        r->job_slots = tasks;
+    if (frames && (r->first = malloc(sizeof *r->first * (size_t)tasks)) != NULL)
+        for (int t = 0; t < tasks; t++)
+            r->first[t] = t ? r->first[t - 1] + frames[t - 1] : 0;
     r->jobs = calloc((size_t)r->job_slots, sizeof *r->jobs);
+    if (frames && !r->first)
+        return out_of_memory(err);
     r->work_dir = absolute_path(opts->work_dir);
     r->chunk_prefix = r->work_dir ? str_printf("%s/povray", r->work_dir) : NULL;
     if (!r->jobs || !r->chunk_prefix)
@@ -195,7 +233,7 @@ static int prepare_run(run *r, const povray_chunk *chunks, int count, const povr
     return st;
 }
 
-/* ---------------------------------------------------------------- one chunk's files */
+/* ---------------------------------------------------------------- one task's files */
 
 typedef struct chunk_args {
     char *wrapper, *ini, *output;
@@ -208,37 +246,65 @@ static void free_chunk_args(chunk_args *a)
     free(a->output);
 }
 
-static int prepare_chunk(run *r, int index, chunk_args *a, l2p_error *err)
+/* Where POV-Ray writes frame f of sequence t: +O's name (WORK/povray.sNNN.f.exr) with the
+   frame number before its extension, padded with zeros to the digits of the final frame. */
+static char *frame_output(const run *r, int t, int f)
 {
-    const povray_chunk *c = &r->chunks[index];
+    int digits = 1;
+    for (int final = r->frames[t] > 1 ? r->frames[t] : 2; final >= 10; final /= 10)
+        digits++;
+    return str_printf("%s.s%03d.f%0*d.exr", r->chunk_prefix, t, digits, f);
+}
+
+static int prepare_task(run *r, int t, chunk_args *a, l2p_error *err)
+{
+    const int first = task_first(r, t), n = task_chunks(r, t);
+    const povray_chunk *c = &r->chunks[first];
     memset(a, 0, sizeof *a);
-    char *include = absolute_path(c->include_path), *ini = absolute_path(c->ini_path);
-    char *inc_name = chunk_file_name("povray", index, "inc");
-    char *ini_name = chunk_file_name("povray", index, "ini");
-    char *pov_inc = NULL;
-    a->wrapper = chunk_file_name(r->chunk_prefix, index, "pov");
-    a->output = absolute_path(c->pov_output ? c->pov_output : c->output_exr);
-    int st = include && ini && inc_name && ini_name && a->wrapper && a->output
+    char **include = calloc((size_t)n, sizeof *include), **pov_inc = calloc((size_t)n, sizeof *pov_inc);
+    char *ini = absolute_path(c->ini_path), *ini_name = chunk_file_name("povray", first, "ini");
+    a->wrapper = task_file_name(r, t, "pov");
+    a->output = r->frames ? task_file_name(r, t, "f.exr")
+                          : absolute_path(c->pov_output ? c->pov_output : c->output_exr);
+    int st = include && pov_inc && ini && ini_name && a->wrapper && a->output
                  ? L2P_OK : out_of_memory(err);
-    if (!st && (access(include, R_OK) != 0 || access(ini, R_OK) != 0))
-        st = l2p_fail(err, L2P_FAILED, access(include, R_OK) ? include : ini, 0,
-                      "cannot read: %s", strerror(errno));
+    for (int i = 0; i < n && !st; i++)
+        if (!(include[i] = absolute_path(r->chunks[first + i].include_path)))
+            st = out_of_memory(err);
+        else if (access(include[i], R_OK) != 0)
+            st = l2p_fail(err, L2P_FAILED, include[i], 0, "cannot read: %s", strerror(errno));
+    if (!st && access(ini, R_OK) != 0)
+        st = l2p_fail(err, L2P_FAILED, ini, 0, "cannot read: %s", strerror(errno));
     if (!st)
         st = check_plain(a->output, err);
-    if (!st)
-        unlink(c->output_exr);  /* a stale EXR must not pass for this run's */
-    if (!st)
-        st = readable_for_povray(r, include, inc_name, &pov_inc, err);
+    for (int i = 0; i < n && !st; i++) {
+        unlink(r->chunks[first + i].output_exr);  /* a stale EXR must not pass for this run's */
+        char *stale = r->frames ? frame_output(r, t, i + 1) : NULL;
+        if (stale)
+            unlink(stale);
+        char *inc_name = chunk_file_name("povray", first + i, "inc");
+        st = inc_name && (stale || !r->frames)
+                 ? readable_for_povray(r, include[i], inc_name, &pov_inc[i], err)
+                 : out_of_memory(err);
+        free(stale);
+        free(inc_name);
+    }
     if (!st)
         st = readable_for_povray(r, ini, ini_name, &a->ini, err);
     if (!st)
-        st = povray_write_wrapper(a->wrapper, r->scene_for_povray, pov_inc, index, c, r->opts,
-                                  err);
+        st = r->frames ? povray_write_sequence_wrapper(a->wrapper, r->scene_for_povray,
+                                                       (const char *const *)pov_inc, n, t,
+                                                       r->opts, err)
+                       : povray_write_wrapper(a->wrapper, r->scene_for_povray, pov_inc[0],
+                                              first, c, r->opts, err);
+    for (int i = 0; i < n && include && pov_inc; i++) {
+        free(include[i]);
+        free(pov_inc[i]);
+    }
     free(include);
-    free(ini);
-    free(inc_name);
-    free(ini_name);
     free(pov_inc);
+    free(ini);
+    free(ini_name);
     return st;
 }
 
@@ -294,14 +360,15 @@ static pid_t spawn(const run *r, char **argv, int log_fd)
     return pid;
 }
 
-static int start_job(run *r, job *j, int index, l2p_error *err)
+static int start_job(run *r, job *j, int t, l2p_error *err)
 {
     chunk_args a;
-    int st = prepare_chunk(r, index, &a, err);
-    const povray_cmd cmd = {r->exe, a.ini, a.wrapper, a.output, r->scene_dir_for_povray};
-    char **argv = st ? NULL : povray_argv(&cmd, &r->chunks[index], r->opts);
+    int st = prepare_task(r, t, &a, err);
+    const povray_cmd cmd = {r->exe, a.ini, a.wrapper, a.output, r->scene_dir_for_povray,
+                            r->frames ? r->frames[t] : 0};
+    char **argv = st ? NULL : povray_argv(&cmd, &r->chunks[task_first(r, t)], r->opts);
     free(j->log_path);
-    j->log_path = chunk_file_name(r->chunk_prefix, index, "log");
+    j->log_path = task_file_name(r, t, "log");
     if (!st && (!argv || !j->log_path))
         st = out_of_memory(err);
     const int fd = st ? -1 : open(j->log_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
@@ -313,7 +380,8 @@ static int start_job(run *r, job *j, int index, l2p_error *err)
             j->pid = 0;
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
         }
-        j->chunk = index;
+        j->task = t;
+        j->frame = 0;
         j->parse_fraction = j->render_fraction = 0;
     }
     if (fd >= 0)
@@ -357,12 +425,15 @@ static void stop_jobs(run *r)
     }
 }
 
-/* Why a job failed, in POV-Ray's own words when its log has them. */
-static int explain_failure(const run *r, const job *j, int status, l2p_error *err)
+/* Why a job failed, in POV-Ray's own words when its log has them (a sequence's: those of the
+   frame it failed in). */
+static int explain_failure(const run *r, job *j, int status, l2p_error *err)
 {
-    char *wrapper = chunk_file_name(r->chunk_prefix, j->chunk, "pov");
+    if (r->frames)
+        j->frame = povray_log_frame(j->log_path, j->frame);
+    char *wrapper = task_file_name(r, j->task, "pov");
     const povray_log_names names = {r->opts->scene_path, r->scene_real_dir,
-                                    {wrapper, r->chunks[j->chunk].include_path},
+                                    {wrapper, r->chunks[job_chunk(r, j)].include_path},
                                     r->links, r->link_count};
     int st = povray_log_error(j->log_path, &names, err);
     free(wrapper);
@@ -375,33 +446,54 @@ static int explain_failure(const run *r, const job *j, int status, l2p_error *er
                     WIFEXITED(status) ? WEXITSTATUS(status) : -1, j->log_path);
 }
 
-/* A finished job: success needs exit status 0 and the EXR on disk. */
-static int check_finished(const run *r, const job *j, int status, l2p_error *err)
+/* A finished job: success needs exit status 0 and the EXR on disk; a sequence's frames are
+   moved to their chunks' output_exr. */
+static int check_finished(const run *r, job *j, int status, l2p_error *err)
 {
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
         return explain_failure(r, j, status, err);
-    const char *out = r->chunks[j->chunk].output_exr;
-    if (access(out, R_OK) != 0)
-        return l2p_fail(err, L2P_FAILED, out, 0, "POV-Ray finished without writing it (log: %s)",
-                        j->log_path);
-    return L2P_OK;
+    int st = L2P_OK;
+    for (int i = 0; i < task_chunks(r, j->task) && !st; i++) {
+        const char *out = r->chunks[task_first(r, j->task) + i].output_exr;
+        char *frame = r->frames ? frame_output(r, j->task, i + 1) : NULL;
+        const char *written = frame ? frame : out;
+        if (r->frames && !frame)
+            st = out_of_memory(err);
+        else if (access(written, R_OK) != 0)
+            st = l2p_fail(err, L2P_FAILED, written, 0,
+                          "POV-Ray finished without writing it (log: %s)", j->log_path);
+        else if (frame && rename(frame, out) != 0)
+            st = l2p_fail(err, L2P_FAILED, out, 0, "cannot move %s here: %s", frame,
+                          strerror(errno));
+        free(frame);
+    }
+    return st;
 }
 
 /* ---------------------------------------------------------------- progress */
 
+/* finished: the chunks of the tasks that have ended; a sequence's frames count as they go. */
 static void draw_progress(run *r, int finished)
 {
     if (!r->bar.enabled || r->writing)
         return;
     double sum = finished;
     int running = 0;
-    for (int i = 0; i < r->job_slots; i++)
-        if (r->jobs[i].pid) {
-            povray_log_progress(r->jobs[i].log_path, r->chunks[r->jobs[i].chunk].faces,
-                                &r->jobs[i].parse_fraction, &r->jobs[i].render_fraction);
-            sum += 0.5 * r->jobs[i].parse_fraction + 0.5 * r->jobs[i].render_fraction;
-            running++;
+    for (int i = 0; i < r->job_slots; i++) {
+        job *j = &r->jobs[i];
+        if (!j->pid)
+            continue;
+        const int frame = r->frames ? povray_log_frame(j->log_path, j->frame) : 0;
+        if (frame != j->frame) {
+            j->frame = frame;
+            j->parse_fraction = j->render_fraction = 0;
         }
+        povray_log_progress(j->log_path, r->chunks[job_chunk(r, j)].faces, &j->parse_fraction,
+                            &j->render_fraction);
+        sum += (j->frame > 1 ? j->frame - 1 : 0) + 0.5 * j->parse_fraction +
+               0.5 * j->render_fraction;
+        running++;
+    }
     char detail[64];
     snprintf(detail, sizeof detail, "%d of %d chunks done, %d running", finished, r->count,
              running);
@@ -411,22 +503,23 @@ static void draw_progress(run *r, int finished)
 /* ---------------------------------------------------------------- the scheduler */
 
 /* A run that failed for a passing cause (povray_log_transient) is started again, at most
-   TRANSIENT_RETRIES times a chunk, with a warning. Returns whether it was. */
+   TRANSIENT_RETRIES times a task, with a warning. Returns whether it was. */
 static bool retried(run *r, job *j, int status, int *st, l2p_error *err)
 {
     if (*st || (WIFEXITED(status) && WEXITSTATUS(status) == 0) || j->retries >= TRANSIENT_RETRIES ||
         !povray_log_transient(j->log_path))
         return false;
-    fprintf(stderr, "lens2pov: warning: POV-Ray timed out starting its threads on chunk %d (a "
-                    "loaded machine); starting it again\n", j->chunk);
+    fprintf(stderr, "lens2pov: warning: POV-Ray timed out starting its threads (a loaded "
+                    "machine); starting it again\n");
     const int retries = j->retries + 1;
-    *st = start_job(r, j, j->chunk, err);
+    *st = start_job(r, j, j->task, err);
     j->retries = retries;
     return true;
 }
 
-/* Reaps the jobs that ended; returns how many did, and the first failure in *st. */
-static int reap_jobs(run *r, int *st, l2p_error *err)
+/* Reaps the jobs that ended; returns how many did, adds their chunks to *chunks, and gives
+   the first failure in *st. */
+static int reap_jobs(run *r, int *chunks, int *st, l2p_error *err)
 {
     int ended = 0;
     for (int i = 0; i < r->job_slots; i++) {
@@ -440,6 +533,7 @@ static int reap_jobs(run *r, int *st, l2p_error *err)
             continue;
         ended++;
         j->retries = 0;
+        *chunks += task_chunks(r, j->task);
         if (!*st)
             *st = check_finished(r, j, status, err);
     }
@@ -460,39 +554,42 @@ static int poll_chunks(run *r, int *ready, l2p_error *err)
                         total > *ready ? total : *ready, r->count);
     if (!st && total >= 0)
         r->count = total;
+    if (!r->frames)
+        r->tasks = r->count;
     r->writing = !st && total < 0;
     return st;
 }
 
 static int schedule(run *r, l2p_error *err)
 {
-    int next = 0, finished = 0, ready = 0, st = L2P_OK;
-    for (int tick = 0; !st && finished < r->count; tick++) {
+    int next = 0, finished = 0, chunks_done = 0, ready = 0, st = L2P_OK;
+    for (int tick = 0; !st && finished < r->tasks; tick++) {
         st = poll_chunks(r, &ready, err);
-        for (int i = 0; i < r->job_slots && next < ready && next < r->count && !st; i++)
+        for (int i = 0; i < r->job_slots && next < r->tasks && !st &&
+                        task_first(r, next) + task_chunks(r, next) <= ready; i++)
             if (!r->jobs[i].pid)
                 st = start_job(r, &r->jobs[i], next++, err);
-        const int ended = st ? 0 : reap_jobs(r, &st, err);
+        const int ended = st ? 0 : reap_jobs(r, &chunks_done, &st, err);
         finished += ended;
         if (ended || st)
             continue;  /* start the next chunks at once */
         if (tick % DRAW_EVERY_TICKS == 0)
-            draw_progress(r, finished);
+            draw_progress(r, chunks_done);
         sleep_ms(TICK_MS);
     }
     if (!st)
-        draw_progress(r, finished);
+        draw_progress(r, chunks_done);
     stop_jobs(r);  /* only a failed run has any left */
     return st;
 }
 
-int povray_render_chunks(const povray_chunk *chunks, int count, const povray_options *opts,
-                         l2p_error *err)
+static int render(const povray_chunk *chunks, int count, const int *frames, int tasks,
+                  const povray_options *opts, l2p_error *err)
 {
-    if (count <= 0)
+    if (count <= 0 || tasks <= 0)
         return L2P_OK;
     run r;
-    int st = prepare_run(&r, chunks, count, opts, err);
+    int st = prepare_run(&r, chunks, count, frames, tasks, opts, err);
     if (!st) {
         progress_start(&r.bar, "POV-Ray", opts->show_progress);
         st = schedule(&r, err);
@@ -500,4 +597,25 @@ int povray_render_chunks(const povray_chunk *chunks, int count, const povray_opt
     }
     free_run(&r);
     return st;
+}
+
+int povray_render_chunks(const povray_chunk *chunks, int count, const povray_options *opts,
+                         l2p_error *err)
+{
+    return render(chunks, count, NULL, count, opts, err);
+}
+
+int povray_render_sequences(const povray_chunk *chunks, const int *frames, int sequences,
+                            const povray_options *opts, l2p_error *err)
+{
+    int count = 0;
+    for (int t = 0; t < sequences; t++) {
+        if (frames[t] < 1)
+            return l2p_fail(err, L2P_FAILED, NULL, 0, "sequence %d has no chunks", t);
+        count += frames[t];
+    }
+    if (opts->user_arg_count > 0 || opts->chunks_ready)
+        return l2p_fail(err, L2P_FAILED, NULL, 0,
+                        "sequences take neither POV-Ray's options nor chunks still being written");
+    return render(chunks, count, frames, sequences, opts, err);
 }

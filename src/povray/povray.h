@@ -55,4 +55,18 @@ typedef struct povray_options {
 int povray_render_chunks(const povray_chunk *chunks, int count, const povray_options *opts,
                          l2p_error *err);
 
+/* The same with one POV-Ray process a sequence: sequence s, the frames[s] (at least 1) chunks
+   after those of the sequences before it, is rendered as the frames of one POV-Ray animation,
+   each frame's wrapper including its own chunk's camera (chosen by frame_number), so that the
+   process's start-up and exit are paid once. The first chunk's ini gives every frame's size:
+   POV-Ray renders all frames of a run at one Width and Height. Each frame's picture is moved
+   to its chunk's output_exr when its process has ended. The scene sees clock 0 and
+   frame_number, initial_frame, final_frame, initial_clock, final_clock and clock_delta as in
+   a still, but clock_on true (POV-Ray lets no scene redeclare it). Chunks take no placement
+   or pov_output, opts no user_args (POV-Ray's animation is lens2pov's here) and no
+   chunks_ready. opts->jobs sequences at a time; failures as povray_render_chunks, POV-Ray's
+   error lines those of the frame that failed. */
+int povray_render_sequences(const povray_chunk *chunks, const int *frames, int sequences,
+                            const povray_options *opts, l2p_error *err);
+
 #endif

@@ -92,6 +92,40 @@ int povray_write_wrapper(const char *path, const char *scene, const char *includ
     return L2P_OK;
 }
 
+/* A sequence's wrapper: each frame is a still of the scene through its own chunk's camera.
+   POV-Ray's animation only takes the frames through one process: the clock stays 0 (+KI0
+   +KF0 on the command line), the frame's number is kept as Lens2pov_Frame, and the other
+   animation identifiers are declared, before the scene, with the values of a still (in
+   3.7.0.10 a #declare shadows them, as it does image_width; clock and clock_on it refuses). */
+int povray_write_sequence_wrapper(const char *path, const char *scene,
+                                  const char *const *includes, int n, int index,
+                                  const povray_options *o, l2p_error *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    fprintf(f,
+            "// lens2pov: sequence %d, %d chunks of the lens camera as the frames of one POV-Ray\n"
+            "// run, each a still of the scene through its chunk's camera, declared after the scene\n"
+            "// so that it replaces the scene's own camera.\n"
+            "#declare Lens2pov_Frame = frame_number;\n", index, n);
+    static const char *const still[] = {"frame_number", "initial_frame", "final_frame",
+                                        "initial_clock", "final_clock", "clock_delta"};
+    for (size_t i = 0; i < sizeof still / sizeof still[0]; i++)
+        fprintf(f, "#declare %s = 0;\n", still[i]);
+    if (o->film_width > 0)
+        fprintf(f, "#declare image_width = %d;\n#declare image_height = %d;\n", o->film_width,
+                o->film_height);
+    fprintf(f, "#include \"%s\"\n#switch (Lens2pov_Frame)\n", scene);
+    for (int i = 0; i < n; i++)
+        fprintf(f, "  #case (%d) #include \"%s\" #break\n", i + 1, includes[i]);
+    fprintf(f, "#end\n#undef Lens2pov_Frame\n");
+    const bool bad = ferror(f) != 0;
+    if (fclose(f) != 0 || bad)
+        return l2p_fail(err, L2P_FAILED, path, 0, "cannot write: %s", strerror(errno));
+    return L2P_OK;
+}
+
 /* The command line. POV-Ray's own options from the user come first, so that everything after
    them overrides what they (or an .ini they name) set: the chunk's ini (its size), then no
    display, no pause, no continuing an old render, no alpha (it zeroes the background), no
@@ -99,10 +133,12 @@ int povray_write_wrapper(const char *path, const char *scene, const char *includ
    statistics, EXR, and Display_Gamma=sRGB, which sets how a scene without gamma handling
    is decoded into the linear EXR. An animation frame is rendered alone as a subset (+SF,
    +EF) of the user's animation, so that the scene sees POV-Ray's own clock, frame_number
-   and the rest. Paths are quoted for spaces. */
+   and the rest. A sequence of n chunks is frames 1 to n of an animation whose clock stays 0;
+   POV-Ray renders a one-frame animation as a still, so one chunk is frame 1 of 2. Paths are
+   quoted for spaces. */
 char **povray_argv(const povray_cmd *cmd, const povray_chunk *c, const povray_options *o)
 {
-    enum { OWN = 24 };
+    enum { OWN = 28 };
     const int n_all = o->user_arg_count + OWN;
     char **argv = calloc((size_t)n_all, sizeof *argv);
     if (!argv)
@@ -124,6 +160,16 @@ char **povray_argv(const povray_cmd *cmd, const povray_chunk *c, const povray_op
     if (c->pov_output) {
         argv[n++] = str_printf("+SF%d", c->frame);
         argv[n++] = str_printf("+EF%d", c->frame);
+    }
+    if (cmd->frames > 0) {
+        argv[n++] = strdup("+KFI1");
+        argv[n++] = str_printf("+KFF%d", cmd->frames > 1 ? cmd->frames : 2);
+        argv[n++] = strdup("+KI0");
+        argv[n++] = strdup("+KF0");
+        if (cmd->frames == 1) {
+            argv[n++] = strdup("+SF1");
+            argv[n++] = strdup("+EF1");
+        }
     }
     for (int i = 0; i < n; i++)
         if (!argv[i]) {

@@ -18,9 +18,17 @@ char *folder_of(const char *abs_path);
 int povray_write_wrapper(const char *path, const char *scene, const char *include, int index,
                          const povray_chunk *c, const povray_options *o, l2p_error *err);
 
-/* The files and folders of one run, as POV-Ray reads them. */
+/* The wrapper of a sequence of n chunks rendered as one animation (povray_render_sequences):
+   frame f includes includes[f - 1]. */
+int povray_write_sequence_wrapper(const char *path, const char *scene,
+                                  const char *const *includes, int n, int index,
+                                  const povray_options *o, l2p_error *err);
+
+/* The files and folders of one run, as POV-Ray reads them; frames: the chunks of a sequence
+   (0: one chunk, no animation of lens2pov's own). */
 typedef struct povray_cmd {
     const char *exe, *ini, *wrapper, *output, *scene_dir;
+    int frames;
 } povray_cmd;
 
 /* The command line (NULL-terminated, malloc'd; NULL out of memory). */

@@ -12,6 +12,7 @@ enum {
                                   (< x , y , z > ,) for a face's indices and for each of its
                                   vertices, of which neighbours on a shared edge have two */
     PROGRESS_TAIL = 256,       /* bytes of a log read for the latest status line */
+    FRAME_TAIL = 65536,        /* bytes of an animation's log searched for its frame */
     ERROR_TAIL = 65536,        /* bytes of a failed log searched for POV-Ray's messages */
     MAX_MESSAGES = 64
 };
@@ -32,6 +33,23 @@ static char *read_tail(const char *path, long len)
         s[got] = '\0';
     fclose(f);
     return s;
+}
+
+/* An animation announces each frame on a line "Rendering frame F of N" (twice for the first):
+   the text after the last such line in s, or s. */
+static char *current_frame(char *s, int *frame)
+{
+    static const char mark[] = "Rendering frame ";
+    char *after = s;
+    for (char *p = s; (p = strstr(p, mark)) != NULL; p += sizeof mark - 1) {
+        if (p != s && p[-1] != '\n' && p[-1] != '\r')
+            continue;
+        int f;
+        if (sscanf(p + sizeof mark - 1, "%d", &f) == 1 && frame)
+            *frame = f;
+        after = p + strcspn(p, "\r\n");
+    }
+    return after;
 }
 
 /* One message: POV-Ray wraps long messages onto lines that start with one space. */
@@ -200,7 +218,7 @@ int povray_log_error(const char *log_path, const povray_log_names *names, l2p_er
 {
     char *log = read_tail(log_path, ERROR_TAIL);
     message *m = calloc(MAX_MESSAGES, sizeof *m);
-    const int n = log && m ? split_messages(log, m, MAX_MESSAGES) : 0;
+    const int n = log && m ? split_messages(current_frame(log, NULL), m, MAX_MESSAGES) : 0;
     const int st = report_messages(names, m, n, err);
     free(m);
     free(log);
@@ -211,9 +229,10 @@ int povray_log_error(const char *log_path, const povray_log_names *names, l2p_er
    share is estimated from the chunk's face count. */
 void povray_log_progress(const char *log_path, long long faces, double *parse, double *render)
 {
-    char *tail = read_tail(log_path, PROGRESS_TAIL);
-    if (!tail)
+    char *whole = read_tail(log_path, PROGRESS_TAIL);
+    if (!whole)
         return;
+    char *tail = current_frame(whole, NULL);
     long long a, b;
     for (char *p = tail; (p = strstr(p, "Rendered ")) != NULL; p++)
         if (sscanf(p, "Rendered %lld of %lld", &a, &b) == 2 && b > 0) {
@@ -225,7 +244,16 @@ void povray_log_progress(const char *log_path, long long faces, double *parse, d
             *parse = (double)a * 1000.0 / ((double)faces * TOKENS_PER_FACE);
     if (*parse > 1)
         *parse = 1;
+    free(whole);
+}
+
+int povray_log_frame(const char *log_path, int frame)
+{
+    char *tail = read_tail(log_path, FRAME_TAIL);
+    if (tail)
+        current_frame(tail, &frame);
     free(tail);
+    return frame;
 }
 
 

@@ -20,15 +20,21 @@ typedef struct povray_log_names {
 } povray_log_names;
 
 /* The reason in the log at log_path, as "FILE:LINE: message" in err (L2P_FAILED), with the
-   user's paths; 0 when the log gives none. */
+   user's paths; 0 when the log gives none. In an animation, only the last frame's messages
+   count. */
 int povray_log_error(const char *log_path, const povray_log_names *names, l2p_error *err);
 
 /* The latest progress in the log: the parse (estimated from the chunk's face count) and the
-   render, each in [0, 1]; left as they were when the log says nothing new. */
+   render, each in [0, 1]; left as they were when the log says nothing new. In an animation,
+   only the current frame's. */
 void povray_log_progress(const char *log_path, long long faces, double *parse, double *render);
 
 /* Whether a failed run's log says it failed for a passing cause (its threads were slow to
    start on a loaded machine): the run may be started again. */
 bool povray_log_transient(const char *log_path);
+
+/* The frame an animation's log is at ("Rendering frame F of N"), or frame when its tail
+   names none. */
+int povray_log_frame(const char *log_path, int frame);
 
 #endif
