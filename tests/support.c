@@ -152,7 +152,9 @@ char *read_text(const char *path, size_t *length)
 
 /* LeakSanitizer's stop-the-world tracer sometimes crashes at exit of a process that had
    threads (google/sanitizers#1353): the run itself finished, but its status is LSan's. Only
-   that exact message, without a leak report, is taken for the sanitizer's failure. */
+   that exact message, without a leak report, is taken for the sanitizer's failure, and the
+   run is made again up to LSAN_RETRIES times: on a loaded machine three in a row were seen. */
+enum { LSAN_RETRIES = 6 };
 static bool lsan_crashed(const char *errtext)
 {
     return errtext && strstr(errtext, "LeakSanitizer has encountered a fatal error") &&
@@ -212,7 +214,7 @@ int run_lens2pov_argv(char **out, char **errout, char *const args[])
     argv[n] = NULL;
     char *o, *e;
     int status = spawn_once(argv, &o, &e);
-    for (int retry = 0; retry < 2 && lsan_crashed(e); retry++) {
+    for (int retry = 0; retry < LSAN_RETRIES && lsan_crashed(e); retry++) {
         cr_log_warn("LeakSanitizer's tracer crashed at exit; running again: %s", argv[1] ? argv[1] : "");
         free(o);
         free(e);
