@@ -70,7 +70,7 @@ static void expect_same_alone(const char *dir, const char *work, int r)
              "cd '%s' && povray '%s/field.f%03d.ini' +I'%s' +O'%s/alone.exr' -D -P -C -UA -A "
              "-V -GS -GR +FE Display_Gamma=sRGB >'%s/alone.log' 2>&1", dir, work, r, wrapper, dir,
              dir);
-    cr_assert_eq(system(cmd), 0, "POV-Ray alone on render %d failed (%s/alone.log)", r, dir);
+    cr_assert_eq(system_povray(cmd), 0, "POV-Ray alone on render %d failed (%s/alone.log)", r, dir);
     int w[2], h[2];
     float *px[2];
     l2p_error err;
