@@ -415,7 +415,10 @@ Test(povray, a_thread_startup_timeout_is_retried)
 static char *counting_povray(const char *dir)
 {
     char *script = fmt("%s/%s", dir, "countpov"), *starts = fmt("%s/%s", dir, "starts");
-    char *text = fmt("#!/bin/sh\necho start >> '%s'\nexec povray \"$@\"\n%s", starts, "");
+    /* a start that timed out starting its threads (the runner starts it again) is not one */
+    char *text = fmt("#!/bin/sh\npovray \"$@\" 2>\"$0.err.$$\"; st=$?\ncat \"$0.err.$$\" >&2\n"
+                     "grep -q 'Timed out waiting for worker thread startup' \"$0.err.$$\" || "
+                     "echo start >> '%s'\nrm -f \"$0.err.$$\"\nexit $st\n%s", starts, "");
     write_text(script, text);
     chmod(script, 0755);
     free(text);

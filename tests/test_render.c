@@ -593,9 +593,19 @@ Test(render, povray_starts_on_a_chunk_while_the_rest_are_written)
     PATH(csv, dir, "rays.csv");
     PATH(keep, dir, "work");
     write_text(scene, MODERN "background { rgb 0.5 }\n");
-    run_lens2pov_ok("render", "render", scene, DGAUSS, "--width", "128", "--height", "96",
-                 "--spp", "16", PLACE, "--jobs", "2", "--rays", csv,
-                 "--keep-temp", keep, "--quiet", "-o", out, NULL);
+    char *errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "render", scene, DGAUSS, "--width", "128",
+                              "--height", "96", "--spp", "16", PLACE, "--jobs", "2", "--rays", csv,
+                              "--keep-temp", keep, "--quiet", "-o", out, NULL), 0, "%s", errtext);
+    /* A chunk that POV-Ray failed to start (it timed out starting its threads) is started
+       again, its wrapper written anew: the wrapper's time then says nothing of the first. */
+    const bool restarted = errtext && strstr(errtext, "starting it again");
+    free(errtext);
+    if (restarted) {
+        cr_log_warn("POV-Ray was started again on a chunk: the start times cannot be compared");
+        remove_tree(dir);
+        return;
+    }
     const int chunks = count_entries(keep, "rays.c", NULL, 0) / 3;   /* .inc .ini .exr */
     cr_assert_eq(chunks, 2, "%d chunks", chunks);
     char first[600], last[600];
