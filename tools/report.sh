@@ -1,13 +1,17 @@
 #!/bin/sh
-# make report: image error against wall time for the seed's three variants on every lens, and the
-# ray-level error of the thick-lens approximation. Writes out/report/ (README.md explains it).
+# make report: image error against wall time for the seed's three variants on every lens, the
+# ray-level error of the thick-lens approximation, and then pixel against field sampling on the
+# four standard lenses, at this film (tools/report_field.sh) and at render's default film and spp
+# (tools/report_default_film.sh). Writes out/report/ (README.md, field.md and default-film.md
+# explain it). docs/benchmarks.md gives its duration; the references are cached
+# (out/report/cache/, keyed by lens, scene, camera, size, spp and binary), shared by the parts.
 #
 #   sh tools/report.sh [BUILD]     (BUILD: the folder holding lens2pov; default build)
 #
 # Environment: SCENE (default pov/scene.pov) with CAMERA (its placement options; default the
 # bundled scene's camera), SIZE (default 128x96), SPPS (default "1 4 16 64 256"), REF_SPP
-# (default 1024), JOBS (default 2). About 12 minutes on 2 cores with a cold cache, 9 with the
-# references cached (out/report/cache/, keyed by lens, scene, camera, size, spp and binary).
+# (default 1024), JOBS (default 2); the field parts read them too (tools/report_default_film.sh:
+# SCENE, CAMERA, JOBS), and their own.
 set -eu
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -195,6 +199,10 @@ END {
     print ""
     print "![RMSE against wall time](error-vs-time.png)"
     print ""
+    print "Pixel against field sampling (`--sampling`) on the four standard lenses: at this film, with"
+    print "these references, [field.md](field.md); at render'"'"'s default film and spp, 640x480 and 16,"
+    print "[default-film.md](default-film.md)."
+    print ""
     print "## In short"
     print ""
     lo_s = 0; hi_s = -9
@@ -310,4 +318,9 @@ END {
     print "  curves lie close together (rear-full and stop-image-full on dgauss and the fisheye)."
 }' "$csv" "$ray_csv" "$work/b.csv" >"$work/README.md"
 mv "$work/README.md" "$out/README.md"
-say "done in ${elapsed}s: $out/README.md, $csv, $out/error-vs-time.png, $ray_csv"
+say "variants done in ${elapsed}s: $out/README.md, $csv, $out/error-vs-time.png, $ray_csv"
+
+# The field parts, with this run's copy of the binary (the same hash: the same references).
+sh tools/report_field.sh "$work" || die "tools/report_field.sh failed"
+sh tools/report_default_film.sh "$work" || die "tools/report_default_film.sh failed"
+say "done in $(($(date +%s) - started))s"
