@@ -39,7 +39,7 @@ TEST_C  = $(wildcard tests/*.c)
 TEST_OBJ = $(TEST_C:tests/%.c=$(BUILD)/tobj/%.o)
 
 .PHONY: all deps test test-unit test-sanitize test-extra bench bench-field-error demo gallery report \
-        stability fuzz valgrind install clean
+        report-field report-default-film stability fuzz valgrind install clean
 
 all: $(BUILD)/lens2pov
 
@@ -116,6 +116,14 @@ gallery: deps $(BUILD)/lens2pov
 
 report: deps $(BUILD)/lens2pov
 	sh tools/report.sh $(BUILD)
+
+# The report's last two parts alone: pixel against field sampling at the report's film
+# (tools/report_field.sh) and at render's default film and spp (tools/report_default_film.sh).
+report-field: deps $(BUILD)/lens2pov
+	sh tools/report_field.sh $(BUILD)
+
+report-default-film: deps $(BUILD)/lens2pov
+	sh tools/report_default_film.sh $(BUILD)
 
 stability: deps $(BUILD)/lens2pov
 	sh tools/stability.sh $(BUILD)

@@ -1,13 +1,17 @@
 #!/bin/sh
-# make report: image error against wall time for the seed's three variants on every lens, and the
-# ray-level error of the thick-lens approximation. Writes out/report/ (README.md explains it).
+# make report: image error against wall time for the seed's three variants on every lens, the
+# ray-level error of the thick-lens approximation, and then pixel against field sampling on the
+# four standard lenses, at this film (tools/report_field.sh) and at render's default film and spp
+# (tools/report_default_film.sh). Writes out/report/ (README.md, field.md and default-film.md
+# explain it). docs/benchmarks.md gives its duration; the references are cached
+# (out/report/cache/, keyed by lens, scene, camera, size, spp and binary), shared by the parts.
 #
 #   sh tools/report.sh [BUILD]     (BUILD: the folder holding lens2pov; default build)
 #
 # Environment: SCENE (default pov/scene.pov) with CAMERA (its placement options; default the
 # bundled scene's camera), SIZE (default 128x96), SPPS (default "1 4 16 64 256"), REF_SPP
-# (default 1024), JOBS (default 2). About 12 minutes on 2 cores with a cold cache, 9 with the
-# references cached (out/report/cache/, keyed by lens, scene, camera, size, spp and binary).
+# (default 1024), JOBS (default 2); the field parts read them too (tools/report_default_film.sh:
+# SCENE, CAMERA, JOBS), and their own.
 set -eu
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -19,32 +23,15 @@ ref_spp=${REF_SPP:-1024}
 jobs=${JOBS:-2}
 W=${size%x*} H=${size#*x}
 out=out/report
-cache=$out/cache
-say() { printf 'report: %s\n' "$*" >&2; }
-die() { say "$*"; exit 1; }
-[ -x "$build/lens2pov" ] || die "no $build/lens2pov: run make first"
-[ -r "$scene" ] || die "cannot read scene $scene"
-mkdir -p "$cache"
-work=$(mktemp -d "$out/tmp.XXXXXX")
-trap 'rm -rf "$work"' EXIT
+tool=report
+# shellcheck source=tools/lib_error.sh
+. tools/lib_error.sh
+err_setup "$build"
 started=$(date +%s)
-
-# A private copy: others may rebuild build/lens2pov while this runs, and its hash is the
-# "lens2pov version" of the cache key (there is no --version; the binary changes with the code).
-# The image library goes beside it, where lens2pov looks for it, and into the hash.
-cp "$build/lens2pov" "$build/lens2pov-image-io.so" "$work/"
-bin=$work/lens2pov
-version=$(cat "$bin" "$work/lens2pov-image-io.so" | sha256sum | cut -c1-12)
-# References of other lens2pov builds will not be used again.
-find "$cache" -name 'ref-*.exr' ! -name "*-$version.exr" -exec rm -f {} +
-scene_key=$(printf '%s\n' "$camera" | cat "$scene" - | sha256sum | cut -c1-12)
 unit_mm=$(printf '%s\n' "$camera" | awk '{ for (i = 1; i < NF; i++) if ($i == "--unit-mm") u = $(i + 1) }
                                          END { print u ? u : 1000 }')
-now() { date +%s.%N; }
 # shellcheck disable=SC2086 # $camera is a list of options.
 render() { "$bin" render "$scene" "$@" $camera --width "$W" --height "$H" --jobs "$jobs" --quiet; }
-# RMSE over all pixels and channels (idiff's "RMS error"); idiff exits non-zero on any difference.
-rmse() { idiff "$1" "$2" 2>&1 | sed -n 's/^ *RMS error = //p'; }
 mean() { oiiotool "$1" --printstats | awk '/Stats Avg/ { print ($3 + $4 + $5) / 3 }'; }
 # Median and largest of a column of $work/pairs ("nan": a ray that never reaches the focal plane).
 stats() { awk -v c="$1" '$c != "nan" { print $c }' "$work/pairs" | sort -g |
@@ -57,36 +44,15 @@ ray_csv=$out/thick-lens-ray-error.csv
 echo 'lens,pupil,trace,spp,seconds,rmse,pass_fraction' >"$work/e.csv"
 echo 'lens,variant,mean,reference_mean' >"$work/b.csv"
 echo 'lens,rays_full,rays_thick,rays_both,angle_median_deg,angle_max_deg,focus_plane_median_mm,focus_plane_max_mm,focus_distance_mm' >"$work/r.csv"
-ref_of() {
-    key=$(basename "$1" .dat)-$(sha256sum "$1" | cut -c1-8)-${W}x$H-$ref_spp-$scene_key-$version
-    echo "$cache/ref-$key.exr"
-}
-# The references: full simulation, stop-image pupil, REF_SPP samples, a seed of their own. Two
-# at a time: their time is not measured, and one lens2pov render keeps only about 1.4 of 2
-# cores busy (one POV-Ray parse per chunk, on one thread each).
-todo=''
-for lens in lenses/*.dat; do
-    ref=$(ref_of "$lens")
-    [ -f "$ref" ] || todo="$todo $lens $ref"
-done
-if [ -n "$todo" ]; then
-    say "references at $ref_spp spp, two at a time, into $cache"
-    t0=$(now)
-    export L2P_BIN="$bin" L2P_SCENE="$scene" L2P_CAMERA="$camera" W H ref_spp jobs
-    # shellcheck disable=SC2016,SC2086 # expanded by the inner sh; $todo holds plain paths.
-    printf '%s %s\n' $todo | xargs -n 2 -P 2 sh -c '
-        "$L2P_BIN" render "$L2P_SCENE" "$1" --pupil stop-image --trace full --spp "$ref_spp" \
-            --seed 9001 $L2P_CAMERA --width "$W" --height "$H" --jobs "$jobs" --quiet -o "$2" ||
-            { echo "report: the reference render of $1 failed" >&2; exit 1; }' sh ||
-        die "reference renders failed"
-    ref_note=$(awk -v a="$t0" -v b="$(now)" 'BEGIN { printf "rendered in %.0f s", b - a }')
-else
-    ref_note="cached"
-fi
+# The references (tools/lib_error.sh): pixel sampling, full simulation, stop-image pupil,
+# REF_SPP samples, a seed of their own.
+names=$(for lens in lenses/*.dat; do basename "$lens" .dat; done)
+# shellcheck disable=SC2086 # plain lens names.
+err_references $names
 
 for lens in lenses/*.dat; do
     name=$(basename "$lens" .dat)
-    ref=$(ref_of "$lens")
+    ref=$(err_ref_of "$name")
     for v in $variants; do
         # shellcheck disable=SC2046 # variant_opts gives four plain words.
         set -- $(variant_opts "$v")
@@ -233,6 +199,10 @@ END {
     print ""
     print "![RMSE against wall time](error-vs-time.png)"
     print ""
+    print "Pixel against field sampling (`--sampling`) on the four standard lenses: at this film, with"
+    print "these references, [field.md](field.md); at render'"'"'s default film and spp, 640x480 and 16,"
+    print "[default-film.md](default-film.md)."
+    print ""
     print "## In short"
     print ""
     lo_s = 0; hi_s = -9
@@ -348,4 +318,9 @@ END {
     print "  curves lie close together (rear-full and stop-image-full on dgauss and the fisheye)."
 }' "$csv" "$ray_csv" "$work/b.csv" >"$work/README.md"
 mv "$work/README.md" "$out/README.md"
-say "done in ${elapsed}s: $out/README.md, $csv, $out/error-vs-time.png, $ray_csv"
+say "variants done in ${elapsed}s: $out/README.md, $csv, $out/error-vs-time.png, $ray_csv"
+
+# The field parts, with this run's copy of the binary (the same hash: the same references).
+sh tools/report_field.sh "$work" || die "tools/report_field.sh failed"
+sh tools/report_default_film.sh "$work" || die "tools/report_default_film.sh failed"
+say "done in $(($(date +%s) - started))s"
