@@ -420,7 +420,10 @@ marker_centroid image_marker(const char *path, int c)
 int system_povray(const char *command)
 {
     int status = -1;
-    for (int tries = 0; tries < 3 && status != 0; tries++)
+    for (int tries = 0; tries < 6 && status != 0; tries++) {
+        if (tries)
+            usleep(100000u << (tries - 1));
         status = system(command);
+    }
     return status;
 }

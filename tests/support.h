@@ -22,9 +22,10 @@ void run_lens2pov_ok(const char *what, ...);
 /* The same with the arguments in a NULL-terminated array. */
 int run_lens2pov_argv(char **out, char **errout, char *const args[]);
 
-/* Runs a shell command that runs POV-Ray (system()), up to three times while it fails: POV-Ray
-   3.7 sometimes times out starting its threads on a loaded machine, and lens2pov's runner
-   starts such a run again too (docs/povray.md). Returns the last status. */
+/* Runs a shell command that runs POV-Ray (system()), up to six times while it fails, after
+   pauses of 0.1 s doubling: POV-Ray 3.7 sometimes times out starting its threads on a loaded
+   machine, and lens2pov's runner starts such a run again too (docs/povray.md). Returns the
+   last status. */
 int system_povray(const char *command);
 
 /* A fresh folder under /tmp, removed with everything in it when the test's process exits
