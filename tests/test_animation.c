@@ -36,7 +36,10 @@ static const char *hold(char *buf, const char *dir, const char *name)
     return buf;
 }
 
-Test(animation, frames_named_as_povray_traced_once)
+/* Renders ANIMATED_SCENE's frames 1 to 3 with POV-Ray's own camera and through the lens with
+   sampling; the lens is traced once (the map) and each frame's markers land where POV-Ray's
+   do. */
+static void frames_match_povray(const char *sampling, const char *map)
 {
     const char *dir = test_tmpdir();
     char scene_buf[512], keep_buf[512];
@@ -48,14 +51,15 @@ Test(animation, frames_named_as_povray_traced_once)
     cr_assert_eq(system_povray(cmd), 0, "%s", cmd);
     char *errtext = NULL;
     const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--angle", "scene",
-                       "--jobs", "2", "-q", "--keep-temp", keep, "-o", tmp_path(dir, "lens.png"),
-                       "--", "+KFI1", "+KFF3");
+                       "--sampling", sampling, "--jobs", "2", "-q", "--keep-temp", keep, "-o",
+                       tmp_path(dir, "lens.png"), "--", "+KFI1", "+KFF3");
     cr_assert_eq(st, 0, "render failed: %s", errtext ? errtext : "");
     free(errtext);
     char listing[1024];
     cr_expect_eq(count_entries(dir, "lens", listing, sizeof listing), 3, "%s", listing);
-    cr_expect_eq(count_entries(keep, "rays.map", NULL, 0), 1, "the lens was traced per frame");
-    cr_expect_eq(count_entries(keep, "rays.t", NULL, 0), 0, "a second table was traced");
+    cr_expect_eq(count_entries(keep, map, NULL, 0), 1, "the lens was traced per frame");
+    cr_expect_eq(count_entries(keep, "rays.t", NULL, 0) + count_entries(keep, "field.t", NULL, 0),
+                 0, "a second table was traced");
     for (int f = 1; f <= 3; f++) {
         char own[32], lens[32];
         snprintf(own, sizeof own, "own%d.png", f);
@@ -66,25 +70,37 @@ Test(animation, frames_named_as_povray_traced_once)
             cr_assert(a.found && b.found, "frame %d marker %d missing (POV-Ray %d, lens %d)", f,
                       c, a.found, b.found);
             cr_expect(fabs(a.x - b.x) < 1.0 && fabs(a.y - b.y) < 1.0,
-                      "frame %d marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", f, c, a.x,
-                      a.y, b.x, b.y);
+                      "%s frame %d marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", sampling,
+                      f, c, a.x, a.y, b.x, b.y);
         }
     }
 }
 
-/* A table placed by a frame's transform gives the picture a table traced in place gives; the
-   animation's table in three chunks (each rendered for every frame), the single frame's in
-   one. */
-Test(animation, placed_table_matches_a_single_frame)
+Test(animation, frames_named_as_povray_traced_once)
+{
+    frames_match_povray("pixel", "rays.map");
+}
+
+Test(animation, field_frames_named_as_povray_traced_once)
+{
+    frames_match_povray("field", "field.map");
+}
+
+/* A table placed by a frame's transform gives the picture a table traced in place gives. In
+   pixel sampling the animation's table is in three chunks (each rendered for every frame),
+   the single frame's in one; in field sampling the two meshes are the same, moved by the
+   placement or by the camera's own matrix. */
+static void placed_matches_single(const char *sampling, const char *memory_mb)
 {
     const char *dir = test_tmpdir();
     char scene_buf[512];
     const char *scene = hold(scene_buf, dir, "scene.pov");
     write_text(scene, ANIMATED_SCENE);
-    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--jobs", "2", "--memory-mb",
-                     "0.5", "-q", "-o", tmp_path(dir, "anim.png"), "--", "+KFI0", "+KFF2"), 0);
-    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q", "-o",
-                     tmp_path(dir, "single.png"), "--", "+K1"), 0);
+    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--sampling", sampling, "--jobs",
+                     "2", "--memory-mb", memory_mb, "-q", "-o", tmp_path(dir, "anim.png"), "--",
+                     "+KFI0", "+KFF2"), 0);
+    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--sampling", sampling, "--jobs",
+                     "1", "-q", "-o", tmp_path(dir, "single.png"), "--", "+K1"), 0);
     cr_assert(file_exists(tmp_path(dir, "anim2.png")) && file_exists(tmp_path(dir, "single.png")));
     int w, h, w2, h2;
     float *a, *b;
@@ -95,13 +111,23 @@ Test(animation, placed_table_matches_a_single_frame)
     double worst = 0;
     for (size_t i = 0; i < (size_t)w * (size_t)h * 4; i++)
         worst = fmax(worst, fabs(a[i] - b[i]));
-    cr_expect(worst <= 1.0 / 255.0, "the placed table differs by %g", worst);
+    cr_expect(worst <= 1.0 / 255.0, "%s: the placed table differs by %g", sampling, worst);
     free(a);
     free(b);
 }
 
+Test(animation, placed_table_matches_a_single_frame)
+{
+    placed_matches_single("pixel", "0.5");
+}
+
+Test(animation, placed_field_matches_a_single_frame)
+{
+    placed_matches_single("field", "1000");
+}
+
 /* Declare= reaches the scene, and image_width and image_height read the film's size. */
-Test(animation, declare_and_image_size_reach_the_scene)
+static void declare_reaches(const char *sampling)
 {
     const char *dir = test_tmpdir();
     char scene_buf[512], keep_buf[512];
@@ -110,7 +136,8 @@ Test(animation, declare_and_image_size_reach_the_scene)
                       "#debug concat(\"seen: \", str(Shade, 0, 2), \" \", str(image_width, 0, 0),"
                       " \" \", str(image_height, 0, 0), \"\\n\")\n"
                       "background { rgb Shade }\n");
-    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q",
+    cr_assert_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--sampling", sampling,
+                     "--jobs", "1", "-q",
                      "--location", "0,0,0", "--look-at", "0,0,1", "--keep-temp", keep, "-o",
                      tmp_path(dir, "out.exr"), "--", "Declare=Shade=0.25"), 0);
     size_t n;
@@ -125,6 +152,16 @@ Test(animation, declare_and_image_size_reach_the_scene)
     const float *centre = p + 4 * ((size_t)(h / 2) * (size_t)w + (size_t)(w / 2));
     cr_expect(fabs(centre[0] - 0.25) < 0.02, "centre %g", centre[0]);
     free(p);
+}
+
+Test(animation, declare_and_image_size_reach_the_scene)
+{
+    declare_reaches("pixel");
+}
+
+Test(animation, declare_and_image_size_reach_a_field_render)
+{
+    declare_reaches("field");
 }
 
 /* Refused before any work, naming "--" and the option; nothing written. */

@@ -87,7 +87,7 @@ static void check_subimage(const char *lens, camera_options *o, double tol, uint
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);
     static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Test", world), 0);
+    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Test", world, NULL), 0);
     fclose(f);
     povuv_mesh pm;
     read_field_include(text, &pm);
@@ -201,7 +201,7 @@ Test(field, sub_images_moved_into_a_render_keep_their_rays)
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);
     static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-    cr_assert_eq(field_mesh_write_include(f, &render, "Field_Test", world), 0);
+    cr_assert_eq(field_mesh_write_include(f, &render, "Field_Test", world, NULL), 0);
     fclose(f);
     povuv_mesh pm;
     read_field_include(text, &pm);

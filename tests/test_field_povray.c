@@ -61,7 +61,7 @@ Test(field_povray, the_model_gives_the_rays_povray_traces)
     static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0.25, -0.5, -5};
     FILE *f = fopen(tmp_path(dir, "field.inc"), "w");
     cr_assert_not_null(f);
-    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Rays", world), 0);
+    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Rays", world, NULL), 0);
     fclose(f);
     write_text(tmp_path(dir, "scene.pov"), SCENE);
     char cmd[4096];
@@ -163,7 +163,7 @@ Test(field_povray, povray_renders_a_lens_field_within_the_tolerance)
     const char *dir = test_tmpdir();
     FILE *f = fopen(tmp_path(dir, "field.inc"), "w");
     cr_assert_not_null(f);
-    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Rays", world), 0);
+    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Rays", world, NULL), 0);
     fclose(f);
     write_text(tmp_path(dir, "scene.pov"), LENS_SCENE);
     char cmd[4096];

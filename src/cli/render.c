@@ -376,15 +376,28 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     return st;
 }
 
-/* --sampling field: src/field/field_render.c does the rest, --rays included, which is
-   renamed into place once the picture is. */
+/* --sampling field: src/field does the rest for the table's frames, --rays included, which is
+   renamed into place once the pictures are. */
 static int field_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
-                            outfile *csv, l2p_error *err)
+                            outfile *csv, const table_frames *tf, int table, l2p_error *err)
 {
-    const field_render_options fo = {c->positional[0], ws->dir, c->output, jobs, cores_online(),
-                                     !c->quiet, c->field_tolerance, c->rays_csv ? csv : NULL};
+    field_frame *fr = calloc((size_t)tf->count, sizeof *fr);
+    if (!fr)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i = 0; i < tf->count; i++)
+        fr[i] = (field_frame){tf->frame[i]->output, tf->frame[i]->placement, tf->frame[i]->number};
+    char prefix[8192];
+    if (table == 0)
+        snprintf(prefix, sizeof prefix, "%s/field", ws->dir);
+    else
+        snprintf(prefix, sizeof prefix, "%s/field.t%d", ws->dir, table);
+    const bool with_csv = c->rays_csv && table == 0;
+    const field_render_options fo = {c->positional[0], ws->dir, prefix, fr, tf->count, tf->digits,
+                                     c->povray_args, c->povray_arg_count, jobs, cores_online(),
+                                     !c->quiet, c->field_tolerance, with_csv ? csv : NULL};
     const int st = field_render(cam, &fo, err);
-    return !st && c->rays_csv ? outfile_commit(csv, err) : st;
+    free(fr);
+    return !st && with_csv ? outfile_commit(csv, err) : st;
 }
 
 /* Table t: its camera, then its frames. */
@@ -406,7 +419,7 @@ static int render_table(const render_frames *rf, int t, const workspace *ws, int
         if (!(st = framing_camera_setup(&cam, &l, c, err))) {
             if (t == 0)
                 cli_warn(c, &cam);
-            st = c->field_sampling ? field_and_render(c, &cam, ws, jobs, csv, err)
+            st = c->field_sampling ? field_and_render(c, &cam, ws, jobs, csv, &tf, t, err)
                                    : trace_and_render(c, &cam, ws, jobs, csv, &tf, t, err);
         }
         camera_free(&cam);   /* also after a failed setup, as it always was */
@@ -429,9 +442,6 @@ int render_command(const cli *given, l2p_error *err)
 {
     const int jobs = given->jobs > 0 ? given->jobs : cores_online();
     int st = check_inputs(given, err);
-    if (!st && given->field_sampling && given->povray_args)
-        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "POV-Ray's options after -- (animations) need "
-                      "--sampling pixel");
     if (!st)
         st = size_check_render(given, given->keep_temp ? given->keep_temp : temp_root(), jobs,
                                err);

@@ -1,21 +1,17 @@
-/* render and trace --sampling field: sub-images built on worker threads, their weights into
-   the field map, packed into POV-Ray renders of at most FIELD_FACES_PER_RENDER faces; render
-   runs them through the chunk runner, one animation a job, and develops them from the map
-   (field_develop.c). */
-#include "field/field_render.h"
+/* The files of render and trace --sampling field: sub-images built on worker threads, their
+   weights into the field map, packed into POV-Ray renders of at most FIELD_FACES_PER_RENDER
+   faces, each render's include and ini (field_povray.c runs and develops them). */
+#include "field/field_files.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "field/field_develop.h"
 #include "field/fieldmap.h"
 #include "field/fieldrays.h"
 #include "field/subimage.h"
 #include "raytable/chunk_ini.h"
-#include "image/develop.h"
-#include "image/image_io.h"
 #include "optics/pupil.h"
 #include "povray/povray.h"
 #include "raytable/povmesh.h"
@@ -27,12 +23,6 @@ typedef struct sub {
     field_stats stats;
     field_placement at;        /* where it is rendered */
 } sub;
-
-typedef struct render_plan {
-    int width, height;         /* final picture (POV-Ray renders one more each way) */
-    int first, count;          /* its sub-images */
-    long long faces;
-} render_plan;
 
 typedef struct job {
     const camera *c;
@@ -129,7 +119,7 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
    binary fraction); every later one has its grid and size, with as many sub-images as the
    budget and the grid take, since a POV-Ray process renders all its renders at one size
    (assign_jobs). Returns the number of renders. */
-static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_plan *plans)
+static int pack(sub *subs, int spp, int w, int h, int most_per_render, field_render_plan *plans)
 {
     int renders = 0, grid_n = 1, grid_nx = 1;
     for (int first = 0; first < spp; renders++) {
@@ -153,7 +143,7 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_pl
         }
         if (renders == 0)
             grid_n = best_n, grid_nx = best_nx;
-        render_plan *p = &plans[renders];
+        field_render_plan *p = &plans[renders];
         grid_size(grid_n, grid_nx, w, h, &p->width, &p->height);
         p->first = first, p->count = best_n, p->faces = 0;
         for (int i = 0; i < best_n; i++) {
@@ -164,45 +154,6 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, render_pl
         first += best_n;
     }
     return renders;
-}
-
-/* A POV-Ray process renders its job's renders as the frames of one animation
-   (povray_render_sequences), paying POV-Ray's start-up and exit once a job, not once a
-   render; pack gives them all one size, as a POV-Ray run needs. Renders go, those of the
-   most sub-images first, to the job with the fewest sub-images so far. order gets the renders
-   job by job (in render order within a job), frames each job's count; returns the number of
-   jobs. */
-static int assign_jobs(const render_plan *plans, int renders, int jobs, int *order, int *frames)
-{
-    const int n = jobs < renders ? jobs : renders;
-    int *job_of = malloc(sizeof *job_of * (size_t)renders);
-    long long *load = calloc((size_t)n, sizeof *load);
-    if (!job_of || !load) {
-        free(job_of), free(load);
-        return -1;
-    }
-    for (int r = 0; r < renders; r++)
-        job_of[r] = -1;
-    for (int done = 0; done < renders; done++) {
-        int r = -1, j = 0;
-        for (int i = 0; i < renders; i++)
-            if (job_of[i] < 0 && (r < 0 || plans[i].count > plans[r].count))
-                r = i;
-        for (int i = 1; i < n; i++)
-            if (load[i] < load[j])
-                j = i;
-        job_of[r] = j;
-        load[j] += plans[r].count;
-    }
-    int k = 0;
-    for (int j = 0; j < n; j++) {
-        frames[j] = 0;
-        for (int r = 0; r < renders; r++)
-            if (job_of[r] == j)
-                order[k++] = r, frames[j]++;
-    }
-    free(job_of), free(load);
-    return n;
 }
 
 /* ---------------------------------------------------------------- files */
@@ -220,9 +171,9 @@ static void world_matrix(const camera *c, double m[12])
     m[9] = t.x, m[10] = t.y, m[11] = t.z;
 }
 
-/* The include of render p: its sub-images moved into place. */
-static int write_include(const camera *c, const sub *subs, const render_plan *p, outfile *f,
-                         l2p_error *err)
+/* The include of render p: its sub-images moved into place, the camera by placement last. */
+static int write_include(const camera *c, const sub *subs, const field_render_plan *p,
+                         const char *placement, outfile *f, l2p_error *err)
 {
     field_mesh m;
     field_mesh_init(&m, p->width, p->height);
@@ -234,7 +185,7 @@ static int write_include(const camera *c, const sub *subs, const render_plan *p,
     }
     double world[12];
     world_matrix(c, world);
-    if (!st && field_mesh_write_include(f->fp, &m, "Lens2pov_Field", world) < 0)
+    if (!st && field_mesh_write_include(f->fp, &m, "Lens2pov_Field", world, placement) < 0)
         st = l2p_fail(err, L2P_FAILED, f->final_path, 0, "cannot write");
     field_mesh_free(&m);
     return st ? st : outfile_finish(f, err);
@@ -242,7 +193,7 @@ static int write_include(const camera *c, const sub *subs, const render_plan *p,
 
 /* Its ini: (W+1) x (H+1) pixels, rows 2.. and columns ..W only (FS#261, docs/povray.md), the
    picture named by its absolute path. */
-static int write_ini(const render_plan *p, const char *exr, outfile *f, l2p_error *err)
+static int write_ini(const field_render_plan *p, const char *exr, outfile *f, l2p_error *err)
 {
     char *path = chunk_ini_absolute(exr);
     if (!path)
@@ -276,7 +227,7 @@ static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l
 }
 
 /* The map's tables: each render's size, each sub-image's place and band. */
-static int finish_map(const camera *c, const sub *subs, const render_plan *plans, int renders,
+static int finish_map(const camera *c, const sub *subs, const field_render_plan *plans, int renders,
                       const outfile *f, l2p_error *err)
 {
     const int spp = c->samples.spp;
@@ -300,19 +251,7 @@ static int finish_map(const camera *c, const sub *subs, const render_plan *plans
 
 /* ---------------------------------------------------------------- the whole */
 
-/* The outputs of a field render or trace, all under temporary names until committed: the map,
-   and for each render its include and ini (PREFIX.fNNN.inc, .ini), its picture's name. */
-typedef struct field_files {
-    outfile map;
-    char *map_path;            /* the map's final path (outfile forgets it once committed) */
-    outfile *inc, *ini;
-    povray_chunk *chunk;       /* include, ini and picture paths, faces */
-    render_plan *plans;        /* each render's size and sub-images */
-    int renders;
-} field_files;
-
-/* Removes what was not committed, frees the rest. */
-static void files_free(field_files *f)
+void field_files_free(field_files *f)
 {
     outfile_discard(&f->map);
     for (int r = 0; r < f->renders; r++) {
@@ -335,20 +274,22 @@ static int files_commit(field_files *f, l2p_error *err)
 
 /* Builds the sub-images (weights into the map), packs them and writes every render's include
    and ini and the map's tables, under temporary names. */
-static int build_files(const camera *c, double tolerance_px, int jobs, const char *prefix,
-                       field_files *out, sub **subs_out, l2p_error *err)
+static int build_files(const camera *c, const field_files_request *q, field_files *out,
+                       sub **subs_out, l2p_error *err)
 {
+    const double tolerance_px = q->tolerance_px;
     if (!(tolerance_px > 0) || !isfinite(tolerance_px))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--field-tolerance must be a number of pixels "
                         "above 0 (for exact rays, use --sampling pixel)");
     const int spp = c->samples.spp, w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
-    jobs = jobs > 0 ? jobs : 1;
+    const int jobs = q->jobs > 0 ? q->jobs : 1;
+    const char *prefix = q->prefix;
     field_tolerance tol;
     field_tolerance_of(c, tolerance_px, &tol);
     samplemap_header header;
     povmesh_camera_header(c, &header);
     sub *subs = calloc((size_t)spp, sizeof *subs);
-    render_plan *plans = calloc((size_t)spp, sizeof *plans);
+    field_render_plan *plans = calloc((size_t)spp, sizeof *plans);
     char *map_path = malloc(strlen(prefix) + 8);
     memset(out, 0, sizeof *out);
     *subs_out = subs;
@@ -388,7 +329,7 @@ static int build_files(const camera *c, double tolerance_px, int jobs, const cha
         if (!ch->include_path || !ch->ini_path || !ch->output_exr)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
         if (!st && !(st = outfile_open(&out->inc[r], ch->include_path, err)))
-            st = write_include(c, subs, &plans[r], &out->inc[r], err);
+            st = write_include(c, subs, &plans[r], q->placement, &out->inc[r], err);
         if (!st && !(st = outfile_open(&out->ini[r], ch->ini_path, err)))
             st = write_ini(&plans[r], ch->output_exr, &out->ini[r], err);
     }
@@ -403,92 +344,32 @@ static void subs_free(sub *subs, int spp)
     free(subs);
 }
 
-/* Develops the renders from the map in the workspace, as `develop` does from files. */
-static int develop_from_map(const field_files *f, const char *output, l2p_error *err)
+int field_files_make(const camera *c, const field_files_request *q, field_files *out,
+                     l2p_error *err)
 {
-    field_map m;
-    int st = field_map_read(f->map_path, &m, err);
-    const char **exr = st ? NULL : malloc(sizeof *exr * (size_t)f->renders + 1);
-    if (!st && !exr)
-        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int r = 0; !st && r < f->renders; r++)
-        exr[r] = f->chunk[r].output_exr;
-    if (!st)
-        st = field_develop(&m, exr, f->renders, output, err);
-    free(exr);
-    field_map_free(&m);
-    return st;
-}
-
-/* Each POV-Ray job renders its share of the renders as one animation (assign_jobs). */
-static int render_by_jobs(const field_files *f, int jobs, const povray_options *po, l2p_error *err)
-{
-    povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
-    int *order = calloc((size_t)f->renders + 1, sizeof *order);
-    int *frames = calloc((size_t)f->renders + 1, sizeof *frames);
-    const int n = !by_job || !order || !frames
-                      ? -1 : assign_jobs(f->plans, f->renders, jobs > 0 ? jobs : 1, order, frames);
-    int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int k = 0; k < f->renders && !st; k++)
-        by_job[k] = f->chunk[order[k]];
-    if (!st)
-        st = povray_render_sequences(by_job, frames, n, po, err);
-    free(by_job), free(order), free(frames);
-    return st;
-}
-
-int field_render(const camera *c, const field_render_options *o, l2p_error *err)
-{
-    char *prefix = malloc(strlen(o->work_dir) + 8);
-    if (!prefix)
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    sprintf(prefix, "%s/field", o->work_dir);
-    field_files f;
     sub *subs = NULL;
-    int st = build_files(c, o->tolerance_px, o->jobs, prefix, &f, &subs, err);
-    free(prefix);
-    /* the image library, loading on render's thread meanwhile: fail before POV-Ray runs when
-       it cannot be loaded, and never leave while it is half loaded */
-    l2p_error lib_err;
-    const int lib = image_io_ready(&lib_err);
-    if (!st && lib)
-        st = l2p_fail(err, lib, NULL, 0, "%s", lib_err.text);
+    int st = build_files(c, q, out, &subs, err);
+    if (!st && q->rays_csv)
+        st = write_rays(c, subs, c->samples.spp, q->rays_csv, err);
     if (!st)
-        st = files_commit(&f, err);   /* the workspace's: in place at once */
-    if (!st && o->rays_csv)
-        st = write_rays(c, subs, c->samples.spp, o->rays_csv, err);
+        st = files_commit(out, err);
+    out->stats.renders = out->renders;
+    for (int k = 0; !st && k < c->samples.spp; k++) {
+        out->stats.faces += subs[k].stats.faces;
+        out->stats.passed += subs[k].stats.passed;
+        out->stats.pixels += subs[k].stats.passed + subs[k].stats.blocked;
+    }
     subs_free(subs, c->samples.spp);
-    /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
-    const povray_options po = {.scene_path = o->scene_path, .work_dir = o->work_dir,
-                               .jobs = o->jobs, .threads_per_job = o->threads_per_job,
-                               .show_progress = o->progress, .film_width = c->film.width,
-                               .film_height = c->film.height};
-    if (!st)
-        st = render_by_jobs(&f, o->jobs, &po, err);
-    if (!st)
-        st = develop_from_map(&f, o->output, err);
-    files_free(&f);
     return st;
 }
 
 int field_trace(const camera *c, const field_trace_options *o, field_trace_stats *stats,
                 l2p_error *err)
 {
+    const field_files_request q = {o->prefix, o->jobs, o->tolerance_px, NULL, o->rays_csv};
     field_files f;
-    sub *subs = NULL;
-    int st = build_files(c, o->tolerance_px, o->jobs, o->prefix, &f, &subs, err);
-    if (!st && o->rays_csv)
-        st = write_rays(c, subs, c->samples.spp, o->rays_csv, err);
-    if (!st)
-        st = files_commit(&f, err);
-    memset(stats, 0, sizeof *stats);
-    stats->renders = f.renders;
-    for (int k = 0; !st && k < c->samples.spp; k++) {
-        stats->faces += subs[k].stats.faces;
-        stats->passed += subs[k].stats.passed;
-        stats->pixels += subs[k].stats.passed + subs[k].stats.blocked;
-    }
-    subs_free(subs, c->samples.spp);
-    files_free(&f);
+    const int st = field_files_make(c, &q, &f, err);
+    *stats = f.stats;
+    field_files_free(&f);
     return st;
 }

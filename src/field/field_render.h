@@ -8,10 +8,24 @@
 #include "base/outfile.h"
 #include "camera/camera.h"
 
+/* A picture of a field render: the still, or a frame of the user's animation. */
+typedef struct field_frame {
+    const char *output;        /* the developed picture */
+    const char *placement;     /* the wrapper's #declare of Lens2pov_Placement; NULL: none */
+    int number;                /* POV-Ray's frame number; -1: not an animation */
+} field_frame;
+
 typedef struct field_render_options {
     const char *scene_path;    /* the user's scene */
     const char *work_dir;      /* the workspace: includes, inis, renders, logs */
-    const char *output;        /* the picture */
+    const char *prefix;        /* the workspace's files of this render: PREFIX.map, ... */
+    /* The pictures, each seen through the same renders: frames that differ only in where
+       the camera stands (placement, the transform the renders' camera is moved by). */
+    const field_frame *frames;
+    int frame_count;
+    int frame_digits;          /* POV-Ray pads frame numbers to this many */
+    char *const *povray_args;  /* POV-Ray's options after "--"; NULL: none */
+    int povray_arg_count;
     int jobs;                  /* POV-Ray processes at once, and threads building meshes */
     int threads_per_job;       /* +WTn; 0: POV-Ray's default */
     bool progress;
@@ -48,9 +62,10 @@ typedef struct field_trace_stats {
 int field_trace(const camera *c, const field_trace_options *o, field_trace_stats *stats,
                 l2p_error *err);
 
-/* Builds, writes, renders and develops. L2P_BAD_INPUT naming --sampling pixel when the
-   tolerance is not above 0 or a sub-image would need more faces than pixels; POV-Ray's errors
-   as povray_render_chunks gives them. With rays_csv, the caller commits it on success. */
+/* Builds, writes, renders and develops every frame (field_povray.c). L2P_BAD_INPUT naming
+   --sampling pixel when the tolerance is not above 0 or a sub-image would need more faces
+   than pixels; POV-Ray's errors as povray_render_chunks gives them. With rays_csv, the caller
+   commits it on success. */
 int field_render(const camera *c, const field_render_options *o, l2p_error *err);
 
 #endif

@@ -96,7 +96,8 @@ void field_mesh_povuv_face(const field_mesh *m, int k, povuv_face *f)
 }
 
 /* %.9g gives back a float32 exactly; %.17g a dyadic UV exactly (it has few digits). */
-int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, const double world[12])
+int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, const double world[12],
+                             const char *placement)
 {
     /* as the pixel table's include (docs/povray.md, "Output and gamma"): raise the language
        version to 3.7 only when it is lower, and put it back */
@@ -117,7 +118,8 @@ int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, c
     fprintf(out, "camera { mesh_camera { 1 3 mesh { %s matrix <", name);
     for (int i = 0; i < 12; i++)
         fprintf(out, "%.17g%s", world[i], i < 11 ? ", " : "");
-    fprintf(out, "> } smooth } }\n#undef %s\n", name);
+    fprintf(out, ">%s%s%s } smooth } }\n#undef %s\n", placement ? " transform { " : "",
+            placement ? placement : "", placement ? " }" : "", name);
     fprintf(out, "#ifdef (Lens2pov_Version)\n  #version Lens2pov_Version;\n  #undef Lens2pov_Version\n#end\n");
     return ferror(out) ? -1 : 0;
 }

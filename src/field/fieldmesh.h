@@ -41,7 +41,9 @@ void field_mesh_povuv_face(const field_mesh *m, int k, povuv_face *f);
 /* The include: `#declare NAME = mesh2 {...}` with vertex_vectors, normal_vectors, uv_vectors
    and face_indices, then the camera `mesh_camera { 1 3 mesh { NAME matrix <m> } smooth }`.
    world is the mesh-to-world map as POV-Ray's 4x3 matrix (rows: images of x, y, z, then the
-   translation). Returns 0, or -1 on a write error. */
-int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, const double world[12]);
+   translation). placement names a transform applied after it (an animation frame's), NULL:
+   none. Returns 0, or -1 on a write error. */
+int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, const double world[12],
+                             const char *placement);
 
 #endif

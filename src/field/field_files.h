@@ -1,0 +1,48 @@
+/* The files of a field render or trace (docs/fields.md): the field map, and for each POV-Ray
+   render its include and ini, built from the sub-images; what field_render.c writes and
+   field_povray.c renders and develops. */
+#ifndef LENS2POV_FIELD_FIELD_FILES_H
+#define LENS2POV_FIELD_FIELD_FILES_H
+
+#include "base/outfile.h"
+#include "camera/camera.h"
+#include "field/field_render.h"
+#include "povray/povray.h"
+
+/* One POV-Ray render: its final size (POV-Ray renders one more each way) and sub-images. */
+typedef struct field_render_plan {
+    int width, height;
+    int first, count;
+    long long faces;
+} field_render_plan;
+
+/* The outputs, under temporary names until committed. */
+typedef struct field_files {
+    outfile map;
+    char *map_path;            /* the map's final path (outfile forgets it once committed) */
+    outfile *inc, *ini;
+    povray_chunk *chunk;       /* render r's include, ini and picture paths, faces */
+    field_render_plan *plans;
+    int renders;
+    field_trace_stats stats;
+} field_files;
+
+typedef struct field_files_request {
+    const char *prefix;        /* PREFIX.map, PREFIX.fNNN.inc, PREFIX.fNNN.ini (picture .exr) */
+    int jobs;                  /* threads building meshes */
+    double tolerance_px;
+    /* A transform identifier every render's camera is moved by last (an animation frame's
+       placement, declared by the wrapper); NULL: none. */
+    const char *placement;
+    outfile *rays_csv;         /* --rays: written and finished, not committed; NULL: none */
+} field_files_request;
+
+/* Builds the sub-images and writes the map, every render's include and ini and the CSV, then
+   commits all but the CSV. L2P_BAD_INPUT naming --sampling pixel for a tolerance not above 0
+   or a sub-image that would need more faces than pixels. *out is always set; free it with
+   field_files_free, which removes what was not committed. */
+int field_files_make(const camera *c, const field_files_request *q, field_files *out,
+                     l2p_error *err);
+void field_files_free(field_files *f);
+
+#endif

@@ -1,0 +1,157 @@
+/* The POV-Ray part of render --sampling field: a field's renders through POV-Ray, then each
+   picture developed from the field map. A still without POV-Ray options runs each job's
+   renders as the frames of one POV-Ray animation; with POV-Ray's options (the user's
+   animation, Declare=, ...) every render of every frame is a POV-Ray run of its own, as pixel
+   sampling runs its chunks. */
+#include "field/field_render.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "field/field_develop.h"
+#include "field/field_files.h"
+#include "image/image_io.h"
+#include "povray/povargs.h"
+#include "povray/povray.h"
+
+/* A POV-Ray process renders its job's renders as the frames of one animation
+   (povray_render_sequences), paying POV-Ray's start-up and exit once a job, not once a
+   render; pack gives them all one size, as a POV-Ray run needs. Renders go, those of the
+   most sub-images first, to the job with the fewest sub-images so far. order gets the renders
+   job by job (in render order within a job), frames each job's count; returns the number of
+   jobs. */
+static int assign_jobs(const field_render_plan *plans, int renders, int jobs, int *order, int *frames)
+{
+    const int n = jobs < renders ? jobs : renders;
+    int *job_of = malloc(sizeof *job_of * (size_t)renders);
+    long long *load = calloc((size_t)n, sizeof *load);
+    if (!job_of || !load) {
+        free(job_of), free(load);
+        return -1;
+    }
+    for (int r = 0; r < renders; r++)
+        job_of[r] = -1;
+    for (int done = 0; done < renders; done++) {
+        int r = -1, j = 0;
+        for (int i = 0; i < renders; i++)
+            if (job_of[i] < 0 && (r < 0 || plans[i].count > plans[r].count))
+                r = i;
+        for (int i = 1; i < n; i++)
+            if (load[i] < load[j])
+                j = i;
+        job_of[r] = j;
+        load[j] += plans[r].count;
+    }
+    int k = 0;
+    for (int j = 0; j < n; j++) {
+        frames[j] = 0;
+        for (int r = 0; r < renders; r++)
+            if (job_of[r] == j)
+                order[k++] = r, frames[j]++;
+    }
+    free(job_of), free(load);
+    return n;
+}
+
+/* Each POV-Ray job renders its share of the renders as one animation (assign_jobs). */
+static int render_by_jobs(const field_files *f, int jobs, const povray_options *po, l2p_error *err)
+{
+    povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
+    int *order = calloc((size_t)f->renders + 1, sizeof *order);
+    int *frames = calloc((size_t)f->renders + 1, sizeof *frames);
+    const int n = !by_job || !order || !frames
+                      ? -1 : assign_jobs(f->plans, f->renders, jobs > 0 ? jobs : 1, order, frames);
+    int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < f->renders && !st; k++)
+        by_job[k] = f->chunk[order[k]];
+    if (!st)
+        st = povray_render_sequences(by_job, frames, n, po, err);
+    free(by_job), free(order), free(frames);
+    return st;
+}
+
+static void free_frame_chunks(povray_chunk *pc, int n)
+{
+    for (int k = 0; pc && k < n; k++)
+        if (pc[k].pov_output)   /* else output_exr is the render's own, freed with the files */
+            free((char *)pc[k].output_exr);
+    free(pc);
+}
+
+/* Render r of frame i is run k = r * frames + i: render-major, the largest renders first as
+   packed. An animation frame's picture is named as POV-Ray names it (+O with the frame's
+   number added). NULL out of memory. */
+static povray_chunk *frame_chunks(const field_files *f, const field_render_options *o)
+{
+    const int n = f->renders * o->frame_count;
+    povray_chunk *pc = calloc((size_t)n + 1, sizeof *pc);
+    for (int k = 0; pc && k < n; k++) {
+        const field_frame *fr = &o->frames[k % o->frame_count];
+        pc[k] = f->chunk[k / o->frame_count];
+        pc[k].placement = fr->placement;
+        if (fr->number >= 0) {
+            pc[k].frame = fr->number;
+            pc[k].pov_output = pc[k].output_exr;
+            pc[k].output_exr = povargs_frame_name(pc[k].pov_output, fr->number, o->frame_digits);
+            if (!pc[k].output_exr) {
+                free_frame_chunks(pc, k);
+                return NULL;
+            }
+        }
+    }
+    return pc;
+}
+
+/* Frame i's pictures, one a render, developed from the map. */
+static int develop_frames(const field_files *f, const povray_chunk *pc,
+                          const field_render_options *o, l2p_error *err)
+{
+    field_map m;
+    int st = field_map_read(f->map_path, &m, err);
+    if (st)
+        return st;
+    const char **exr = malloc(sizeof *exr * ((size_t)f->renders + 1));
+    if (!exr)
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i = 0; !st && i < o->frame_count; i++) {
+        for (int r = 0; r < f->renders; r++)
+            exr[r] = pc[r * o->frame_count + i].output_exr;
+        st = field_develop(&m, exr, f->renders, o->frames[i].output, err);
+    }
+    free(exr);
+    field_map_free(&m);
+    return st;
+}
+
+int field_render(const camera *c, const field_render_options *o, l2p_error *err)
+{
+    const field_files_request q = {o->prefix, o->jobs, o->tolerance_px,
+                                   o->frames[0].placement ? "Lens2pov_Placement" : NULL,
+                                   o->rays_csv};
+    field_files f;
+    int st = field_files_make(c, &q, &f, err);
+    /* the image library, loading on render's thread meanwhile: fail before POV-Ray runs when
+       it cannot be loaded, and never leave while it is half loaded */
+    l2p_error lib_err;
+    const int lib = image_io_ready(&lib_err);
+    if (!st && lib)
+        st = l2p_fail(err, lib, NULL, 0, "%s", lib_err.text);
+    /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
+    const povray_options po = {.scene_path = o->scene_path, .work_dir = o->work_dir,
+                               .jobs = o->jobs, .threads_per_job = o->threads_per_job,
+                               .show_progress = o->progress, .user_args = o->povray_args,
+                               .user_arg_count = o->povray_arg_count,
+                               .film_width = c->film.width, .film_height = c->film.height};
+    const bool one_run_a_job = !o->povray_args && o->frame_count == 1 && o->frames[0].number < 0;
+    povray_chunk *pc = st || one_run_a_job ? NULL : frame_chunks(&f, o);
+    if (!st && !one_run_a_job && !pc)
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    if (!st)
+        st = one_run_a_job ? render_by_jobs(&f, o->jobs, &po, err)
+                           : povray_render_chunks(pc, f.renders * o->frame_count, &po, err);
+    if (!st)
+        st = develop_frames(&f, one_run_a_job ? f.chunk : pc, o, err);
+    free_frame_chunks(pc, f.renders * o->frame_count);
+    field_files_free(&f);
+    return st;
+}
