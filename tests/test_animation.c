@@ -238,7 +238,8 @@ Test(animation, frames_from_log)
     scene_frames_free(&f);
 }
 
-/* A focus that follows look_at from frame to frame needs a table a frame. */
+/* A focus that follows look_at from frame to frame needs a field (render's default sampling)
+   a frame. */
 Test(animation, changing_focus_traces_again)
 {
     const char *dir = test_tmpdir();
@@ -253,8 +254,8 @@ Test(animation, changing_focus_traces_again)
                        "+KFF2");
     cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
     free(errtext);
-    cr_expect_eq(count_entries(keep, "rays.map", NULL, 0), 1);
-    cr_expect_eq(count_entries(keep, "rays.t1.map", NULL, 0), 1);
+    cr_expect_eq(count_entries(keep, "field.map", NULL, 0), 1);
+    cr_expect_eq(count_entries(keep, "field.t1.map", NULL, 0), 1);
     cr_expect(file_exists(tmp_path(dir, "f1.png")) && file_exists(tmp_path(dir, "f2.png")));
 }
 

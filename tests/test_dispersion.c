@@ -431,7 +431,8 @@ Test(dispersion, lateral_colour_lies_where_the_paraxial_trace_puts_it, .timeout 
     double shift[2];
     for (int on = 0; on < 2; on++) {
         const char *out = tmp_path(dir, on ? "on.exr" : "off.exr");
-        run_lens2pov_ok("the disk", "render", scene, LENS_DIR "retrofocus.28mm.dat", "--width",
+        run_lens2pov_ok("the disk", "render", scene, LENS_DIR "retrofocus.28mm.dat", "--sampling",
+                        "pixel", "--width",
                         "6000", "--height", "4000", "--film-distance", film, "--f-number", "8",
                         "--crop", crop, "--spp", "64", "--dispersion", on ? "on" : "off",
                         "--quiet", "-o", out, NULL);

@@ -92,6 +92,41 @@ Test(field_render, refuses_a_tolerance_it_cannot_keep)
     cr_expect(!file_exists(tmp_path(dir, "x.png")));
 }
 
+/* render's default sampling is field; a film too small for the fields (the fisheye at 16x12:
+   its image circle's edge needs more faces than the sub-image has pixels) is rendered with
+   pixel sampling, with a note, and gives pixel sampling's picture. Asked for by name, field
+   sampling refuses it. */
+Test(field_render, default_falls_back_to_pixel_sampling_on_a_tiny_film)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *scene = tmp_path(dir, "scene.pov");
+#define TINY LENS_DIR "fisheye-dx.10.5mm.dat", "--width", "16", "--height", "12", "--spp", "4"
+    char *errtext = NULL;
+    cr_assert_eq(L2P(NULL, &errtext, "render", scene, TINY, "--sampling", "field", "-o",
+                     tmp_path(dir, "field.exr")), 2);
+    cr_expect(errtext && strstr(errtext, "faces for 192 pixels"), "%s", errtext ? errtext : "");
+    free(errtext);
+    errtext = NULL;
+    cr_assert_eq(L2P(NULL, &errtext, "render", scene, TINY, "-o", tmp_path(dir, "default.exr")), 0,
+                 "%s", errtext ? errtext : "");
+    cr_expect(errtext && strstr(errtext, "note: rendering with --sampling pixel"), "%s",
+              errtext ? errtext : "");
+    free(errtext);
+    run_lens2pov_ok("pixel", "render", scene, TINY, "--sampling", "pixel", "-q", "-o",
+                    tmp_path(dir, "pixel.exr"), NULL);
+#undef TINY
+    int w, h, w2, h2;
+    float *a, *b;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "default.exr"), &w, &h, &a, &err), 0, "%s", err.text);
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "pixel.exr"), &w2, &h2, &b, &err), 0, "%s", err.text);
+    cr_assert(w == 16 && h == 12 && w2 == 16 && h2 == 12);
+    cr_expect_arr_eq(a, b, sizeof(float) * 4 * 16 * 12, "the fallback is not pixel sampling");
+    cr_expect(!file_exists(tmp_path(dir, "field.exr")));
+    free(a), free(b);
+}
+
 /* How sub-images are packed into renders (here: one render of 4 with one job, two of 2 with
    two) changes no pixel: every UV is a short binary fraction, so every pixel gets the same
    face weights, hence the same ray, in any render. A crop is the crop's size. */

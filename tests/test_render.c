@@ -319,7 +319,8 @@ Test(render, physical_weights_do_not_depend_on_the_pupil)
     profile prof[2];
     for (int k = 0; k < 2; k++) {
         char *errtext;
-        int st = L2P(NULL, &errtext, "render", white, DGAUSS, "--width", "64", "--height", "48",
+        int st = L2P(NULL, &errtext, "render", white, DGAUSS, "--sampling", "pixel",
+                     "--width", "64", "--height", "48",
                      "--spp", "32", "--pupil", pupils[k], "--weighting", "physical", PLACE,
                      "--seed", "5", "--quiet", "-o", outs[k]);
         cr_assert_eq(st, 0, "render --pupil %s: %s", pupils[k], errtext);
@@ -506,10 +507,12 @@ Test(render, crop_is_a_region_of_the_whole_picture)
     PATH(crop, dir, "crop.exr");
     PATH(csv, dir, "crop.csv");
     write_text(scene, SMOOTH_SCENE);
-    run_lens2pov_ok("full", "render", scene, DGAUSS, "--width", "64", "--height", "48",
+    run_lens2pov_ok("full", "render", scene, DGAUSS, "--sampling", "pixel",
+                    "--width", "64", "--height", "48",
                  "--spp", "4", "--f-number", "8", PLACE, "--seed", "3", "--quiet", "-o", full, NULL);
     const int x0 = 7, y0 = 5, x1 = 40, y1 = 29;
-    run_lens2pov_ok("crop", "render", scene, DGAUSS, "--width", "64", "--height", "48", "--spp",
+    run_lens2pov_ok("crop", "render", scene, DGAUSS, "--sampling", "pixel",
+                    "--width", "64", "--height", "48", "--spp",
              "4", "--f-number", "8", PLACE, "--seed", "3", "--crop", "7,5,40,29", "--rays", csv,
              "--quiet", "-o", crop, NULL);
     /* Only the region's rays went to POV-Ray: at most 4 a pixel (the lens blocks a few toward
@@ -561,10 +564,12 @@ Test(render, chunks_and_jobs_do_not_change_the_picture)
     PATH(many, dir, "many.exr");
     PATH(keep, dir, "work");
     write_text(scene, SMOOTH_SCENE);
-    run_lens2pov_ok("--jobs 1", "render", scene, DGAUSS, "--width", "32", "--height", "24",
+    run_lens2pov_ok("--jobs 1", "render", scene, DGAUSS, "--sampling", "pixel",
+                    "--width", "32", "--height", "24",
                  "--spp", "6", "--f-number", "8", PLACE, "--seed", "9", "--jobs", "1", "--quiet",
                  "-o", one, NULL);
-    run_lens2pov_ok("--jobs 2 --memory-mb 0.05", "render", scene, DGAUSS, "--width", "32", "--height", "24", "--spp",
+    run_lens2pov_ok("--jobs 2 --memory-mb 0.05", "render", scene, DGAUSS, "--sampling", "pixel",
+                    "--width", "32", "--height", "24", "--spp",
              "6", "--f-number", "8", PLACE, "--seed", "9", "--jobs", "2", "--memory-mb", "0.05",
              "--keep-temp", keep, "--quiet", "-o", many, NULL);
     const int chunks = count_entries(keep, "rays.c", NULL, 0) / 3;   /* .inc .ini .exr */
@@ -594,7 +599,8 @@ Test(render, povray_starts_on_a_chunk_while_the_rest_are_written)
     PATH(keep, dir, "work");
     write_text(scene, MODERN "background { rgb 0.5 }\n");
     char *errtext = NULL;
-    cr_assert_eq(run_lens2pov(NULL, &errtext, "render", scene, DGAUSS, "--width", "128",
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "render", scene, DGAUSS, "--sampling", "pixel",
+                              "--width", "128",
                               "--height", "96", "--spp", "16", PLACE, "--jobs", "2", "--rays", csv,
                               "--keep-temp", keep, "--quiet", "-o", out, NULL), 0, "%s", errtext);
     /* A chunk that POV-Ray failed to start (it timed out starting its threads) is started
@@ -743,7 +749,8 @@ Test(render, chunks_share_the_faces_equally_between_jobs)
     /* The rear pupil, so that rows differ much in the rays they pass. */
     const char *camera[] = {"--width", "96", "--height", "64", "--spp", "4", "--look-at", "0,0,3",
                             "--pupil", "rear"};
-    run_lens2pov_ok("render", "render", scene, LENS_DIR "wide.22mm.dat", camera[0],
+    run_lens2pov_ok("render", "render", scene, LENS_DIR "wide.22mm.dat", "--sampling", "pixel",
+                    camera[0],
                           camera[1], camera[2], camera[3], camera[4], camera[5], camera[6],
                           camera[7], camera[8], camera[9], "--jobs", "2", "--keep-temp", keep,
                           "-o", image, "--quiet", NULL);

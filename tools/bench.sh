@@ -42,7 +42,7 @@ middle() { printf '%s\n' "$@" | sort -n | sed -n 2p; }
 W=320 H=240 SPP=16
 scene=pov/bench.pov   # the bundled scene with soft shadows: real shading
 lens_render() {
-  "$build/lens2pov" render "$scene" lenses/dgauss.50mm.dat --width $W --height $H --spp $SPP \
+  "$build/lens2pov" render "$scene" lenses/dgauss.50mm.dat --sampling pixel --width $W --height $H --spp $SPP \
       --location 0,1.2,-4 --look-at 0,1,0 -o "$work/lens.png" --quiet "$@"
 }
 # POV-Ray's camera framed as the lens frames it (its field of view from `info`; the scene's own

@@ -31,7 +31,7 @@ camera { perspective location <clock - 0.5, 1.2, -4> look_at <clock - 0.5, 1, 0>
 POV
 
 animation() {
-  "$build/lens2pov" render "$work/anim.pov" $lens --width $W --height $H --spp $SPP \
+  "$build/lens2pov" render "$work/anim.pov" $lens --sampling pixel --width $W --height $H --spp $SPP \
       --quiet -o "$work/lens.png" "$@" -- +L"$root/pov" +KFI1 +KFF$FRAMES
 }
 perspective() {   # each film row rendered SPP times: the same primary rays
@@ -41,7 +41,7 @@ perspective() {   # each film row rendered SPP times: the same primary rays
 every_frame() {   # the lens traced again for each frame: ten one-frame renders
   for f in $(seq 1 $FRAMES); do
     clock=$(awk -v f="$f" -v n=$FRAMES 'BEGIN { print (f - 1) / (n - 1) }')
-    "$build/lens2pov" render "$work/anim.pov" $lens --width $W --height $H --spp $SPP \
+    "$build/lens2pov" render "$work/anim.pov" $lens --sampling pixel --width $W --height $H --spp $SPP \
         --quiet -o "$work/one$f.png" -- +L"$root/pov" +K"$clock"
   done
 }

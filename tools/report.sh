@@ -31,7 +31,7 @@ started=$(date +%s)
 unit_mm=$(printf '%s\n' "$camera" | awk '{ for (i = 1; i < NF; i++) if ($i == "--unit-mm") u = $(i + 1) }
                                          END { print u ? u : 1000 }')
 # shellcheck disable=SC2086 # $camera is a list of options.
-render() { "$bin" render "$scene" "$@" $camera --width "$W" --height "$H" --jobs "$jobs" --quiet; }
+render() { "$bin" render "$scene" --sampling pixel "$@" $camera --width "$W" --height "$H" --jobs "$jobs" --quiet; }
 mean() { oiiotool "$1" --printstats | awk '/Stats Avg/ { print ($3 + $4 + $5) / 3 }'; }
 # Median and largest of a column of $work/pairs ("nan": a ray that never reaches the focal plane).
 stats() { awk -v c="$1" '$c != "nan" { print $c }' "$work/pairs" | sort -g |

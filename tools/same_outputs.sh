@@ -22,7 +22,7 @@ trace_fisheye trace $L/fisheye.10mm.dat --width 16 --height 16 --spp 2 --film-di
 trace_tele_thick trace $L/telephoto.250mm.dat --width 16 --height 12 --spp 2 --trace thick --weighting physical --rays OUT.csv -o OUT
 trace_stop_crop trace $L/dgauss.50mm.dat --width 32 --height 24 --spp 2 --pupil stop --crop 4,4,20,12 --focus-distance 2 --rays OUT.csv -o OUT
 trace_chunks trace $L/dgauss.50mm.dat --width 32 --height 24 --spp 4 --memory-mb 0.05 -o OUT
-render_dgauss render $root/pov/scene.pov $L/dgauss.50mm.dat --width 32 --height 24 --spp 2 --f-number 4 --location 0,1,-4 --look-at 0,0.5,0 --jobs 2 --quiet -o OUT.exr
+render_dgauss render $root/pov/scene.pov $L/dgauss.50mm.dat --sampling pixel --width 32 --height 24 --spp 2 --f-number 4 --location 0,1,-4 --look-at 0,0.5,0 --jobs 2 --quiet -o OUT.exr
 EOF
 }
 

@@ -31,7 +31,8 @@ typedef struct cli {
     bool diagonal_given;         /* --film-diagonal (it contradicts --angle) */
     char *const *povray_args;    /* render: POV-Ray's own options, after "--" */
     int povray_arg_count;
-    bool field_sampling;         /* render --sampling field (docs/fields.md) */
+    bool field_sampling;         /* --sampling field (docs/fields.md); render's default */
+    bool sampling_chosen;        /* --sampling or --field-tolerance given: render keeps to it */
     double field_tolerance;      /* --field-tolerance, pixels [0.05] */
 } cli;
 

@@ -377,7 +377,9 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
 }
 
 /* --sampling field: src/field does the rest for the table's frames, --rays included, which is
-   renamed into place once the pictures are. */
+   renamed into place once the pictures are. By default (neither --sampling nor
+   --field-tolerance), a picture whose sub-images the tolerance cannot draw (a small film:
+   more faces than pixels) is rendered with pixel sampling instead, with a note. */
 static int field_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
                             outfile *csv, const table_frames *tf, int table, l2p_error *err)
 {
@@ -392,11 +394,19 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
     else
         snprintf(prefix, sizeof prefix, "%s/field.t%d", ws->dir, table);
     const bool with_csv = c->rays_csv && table == 0;
+    bool too_fine = false;
     const field_render_options fo = {c->positional[0], ws->dir, prefix, fr, tf->count, tf->digits,
                                      c->povray_args, c->povray_arg_count, jobs, cores_online(),
-                                     !c->quiet, c->field_tolerance, with_csv ? csv : NULL};
+                                     !c->quiet, c->field_tolerance, with_csv ? csv : NULL,
+                                     &too_fine};
     const int st = field_render(cam, &fo, err);
     free(fr);
+    if (st == L2P_BAD_INPUT && too_fine && !c->sampling_chosen) {
+        if (!c->quiet)
+            fprintf(stderr, "lens2pov: note: rendering with --sampling pixel, since field "
+                            "sampling cannot draw this picture (%s)\n", err->text);
+        return trace_and_render(c, cam, ws, jobs, csv, tf, table, err);
+    }
     return !st && with_csv ? outfile_commit(csv, err) : st;
 }
 

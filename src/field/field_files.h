@@ -25,6 +25,8 @@ typedef struct field_files {
     field_render_plan *plans;
     int renders;
     field_trace_stats stats;
+    bool too_fine;             /* failed: a sub-image the tolerance cannot draw (the message
+                                  names --sampling pixel) */
 } field_files;
 
 typedef struct field_files_request {

@@ -130,6 +130,8 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                    o->rays_csv};
     field_files f;
     int st = field_files_make(c, &q, &f, err);
+    if (o->too_fine)
+        *o->too_fine = f.too_fine;
     /* the image library, loading on render's thread meanwhile: fail before POV-Ray runs when
        it cannot be loaded, and never leave while it is half loaded */
     l2p_error lib_err;

@@ -34,6 +34,7 @@ typedef struct job {
     atomic_int next;
     atomic_int status;
     l2p_error err;
+    bool too_fine;             /* the failure is a sub-image the tolerance cannot draw */
     pthread_mutex_t lock;
 } job;
 
@@ -70,6 +71,7 @@ static void *build_worker(void *arg)
                           "--field-tolerance %g needs %d faces for %zu pixels in sub-image %d: "
                           "use a larger tolerance or --sampling pixel", j->tol->pixels,
                           s->stats.faces, pixels, k);
+        const bool too_fine = st == L2P_BAD_INPUT;   /* the two refusals above */
         if (!st)   /* into the map now: spp of them in memory would be spp pictures */
             st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
         free(s->weights);
@@ -78,6 +80,7 @@ static void *build_worker(void *arg)
             pthread_mutex_lock(&j->lock);
             if (atomic_load(&j->status) == L2P_OK) {
                 j->err = e;
+                j->too_fine = too_fine;
                 atomic_store(&j->status, st);
             }
             pthread_mutex_unlock(&j->lock);
@@ -310,6 +313,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     pthread_mutex_init(&j.lock, NULL);
     if (!st)
         st = build_all(&j, jobs, err);
+    out->too_fine = st && j.too_fine;
     pthread_mutex_destroy(&j.lock);
     const int renders = st ? 0 : pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
     if (!st)

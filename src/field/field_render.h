@@ -32,6 +32,9 @@ typedef struct field_render_options {
     double tolerance_px;       /* --field-tolerance */
     outfile *rays_csv;         /* --rays: opened by the caller, written and finished here, not
                                   committed; NULL: none */
+    bool *too_fine;            /* set when the failure is a sub-image the tolerance cannot
+                                  draw (more faces than pixels, or finer than float32);
+                                  NULL: not asked */
 } field_render_options;
 
 /* --field-tolerance's default, in pixels: no picture shows an error this small. */
