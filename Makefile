@@ -93,6 +93,8 @@ test-extra: fuzz valgrind
 
 # The same suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its own build folder.
 test-sanitize: deps
+	@if grep -n '\.timeout *=' tests/*.c; then echo "tests: no .timeout: Criterion's runner then \
+	leaks under AddressSanitizer (tests/test_povray.c)" >&2; exit 1; fi
 	$(MAKE) BUILD=build-san OPT=-O1 \
 	  SAN='$(SANITIZERS)' \
 	  TEST_ARGS='$(TEST_ARGS) --jobs 2' test-unit

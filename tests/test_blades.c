@@ -95,7 +95,7 @@ static void outline(int blades, double out[72])
     camera_free(&c);
 }
 
-Test(blades, a_defocused_point_takes_the_shape_of_the_blades, .timeout = 120)
+Test(blades, a_defocused_point_takes_the_shape_of_the_blades)
 {
     for (int n = 5; n <= 6; n++) {
         double r[72];

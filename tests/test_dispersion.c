@@ -290,7 +290,7 @@ Test(dispersion, focal_lengths_at_f_and_c_match_a_paraxial_trace)
    six wavelengths across the spectrum (the pupil is fitted at the d line and grown for the two
    ends only). Film points on the diagonal, between the pupil's nodes and out to the corner
    (beyond the fisheye's image circle); the full stop and a quarter of it. */
-Test(dispersion, every_passing_ray_at_every_wavelength_lies_in_the_pupil, .timeout = 600)
+Test(dispersion, every_passing_ray_at_every_wavelength_lies_in_the_pupil)
 {
     const char *names[] = {"cooke-triplet.50mm", "retrofocus.28mm", "fisheye-dx.10.5mm"};
     const double nm[] = {382, 420, 486, 550, 656, 778}, along[] = {0, 0.3, 0.52, 0.77, 0.93, 1.0};
@@ -406,7 +406,7 @@ static double paraxial_focus_mm(const lens *l, double nm)
    predicts for the channels' shares of the spectrum, within 15%: the paraxial trace leaves
    out the change of distortion with wavelength, which grows as the angle squared (the render
    falls 8% short of it at 10 degrees, 13% at 15). Without dispersion the channels coincide. */
-Test(dispersion, lateral_colour_lies_where_the_paraxial_trace_puts_it, .timeout = 300)
+Test(dispersion, lateral_colour_lies_where_the_paraxial_trace_puts_it)
 {
     lens l;
     read_lens("retrofocus.28mm", &l);
@@ -454,7 +454,7 @@ Test(dispersion, lateral_colour_lies_where_the_paraxial_trace_puts_it, .timeout 
    vignetted corners and a fisheye's image circle included, with both samplings: the channels
    agree within 1% (the band weights renormalized over the samples that pass; develop.c). At
    16 spp a single blocked sample would otherwise tint a pixel by up to a third. */
-Test(dispersion, a_white_background_stays_neutral, .timeout = 300)
+Test(dispersion, a_white_background_stays_neutral)
 {
     const char *dir = test_tmpdir();
     const char *scene = tmp_path(dir, "white.pov");

@@ -25,7 +25,7 @@ static int shell(const char *fmt, const char *a, const char *b)
     return system(cmd);
 }
 
-Test(install, installs_man_page_script_lenses_and_docs_that_work, .timeout = 120)
+Test(install, installs_man_page_script_lenses_and_docs_that_work)
 {
     const char *prefix = test_tmpdir();
     char *p = strdup(prefix);

@@ -289,7 +289,7 @@ static double estimate(const camera *c, vec3 p, int side, double *std_error)
    corner; beyond the fisheye's image circle both are 0. The tolerance: four standard errors
    of the 128 x 128 samples (0.1-0.5%), plus twice the grid's own error (its change from half
    the density), plus 2e-4 of the value for the rest of the grid's discretization. */
-Test(pupil, irradiance_matches_an_independent_integral_over_the_lens, .timeout = 600)
+Test(pupil, irradiance_matches_an_independent_integral_over_the_lens)
 {
     const double f_numbers[] = {NAN, 8.0, 16.0, 64.0};
     for (int li = 0; li < 4; li++)
@@ -314,7 +314,7 @@ Test(pupil, irradiance_matches_an_independent_integral_over_the_lens, .timeout =
 /* The same through blades (5 and 6, turned by 11 degrees), on the double-Gauss and the wide
    angle at full opening and f/8: the fitted pupil covers the polygon's rays, the weights stay
    unbiased. The independent integral traces the same blades (the kernel's stop test). */
-Test(pupil, irradiance_through_blades_matches_an_independent_integral, .timeout = 600)
+Test(pupil, irradiance_through_blades_matches_an_independent_integral)
 {
     static const char *const lenses[] = {"dgauss.50mm", "wide.22mm"};
     const double f_numbers[] = {NAN, 8.0};
@@ -345,7 +345,7 @@ Test(pupil, irradiance_through_blades_matches_an_independent_integral, .timeout 
    edge, corner (beyond the fisheye's image circle), and four points on the diagonal that fall
    between the pupil's nodes; stops: full, a quarter of the opening, 1/16; focus 10 m and 2 m
    (the telephoto's closest is farther: 4 m). */
-Test(pupil, every_passing_ray_lies_in_the_sampled_region, .timeout = 600)
+Test(pupil, every_passing_ray_lies_in_the_sampled_region)
 {
     const double openings[] = {1.0, 0.25, 1.0 / 16};
     enum { N = 300 };
