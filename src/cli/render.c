@@ -88,9 +88,18 @@ static long long chunk_faces_for(const camera *cam, const cli *c, int jobs, int 
     return per_chunk > 0 ? per_chunk : 1;
 }
 
+/* The image library (about 0.3 s of dlopen) loads on a thread of its own while POV-Ray runs.
+   It is started once the trace's threads exist: while dlopen holds the dynamic loader's lock,
+   glibc's pthread_create waits for it, and the trace waited out the whole load. */
+typedef struct library_loader {
+    pthread_t thread;
+    bool started;
+} library_loader;
+
 typedef struct workspace {
     char dir[4096];
     bool keep;
+    library_loader *library;
 } workspace;
 
 static void remove_workspace(const workspace *w);
@@ -157,6 +166,30 @@ static void remove_workspace(const workspace *w)
     cleanup_untrack(w->dir);
 }
 
+/* Starts a thread with SIGINT, SIGTERM and SIGHUP blocked, so that they reach the main thread,
+   whose handler stops the POV-Ray processes it tracks. */
+static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
+{
+    sigset_t old;
+    cleanup_block_signals(&old);
+    const int r = pthread_create(t, NULL, fn, arg);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return r;
+}
+
+static void *load_image_library(void *arg)
+{
+    (void)arg;
+    image_io_ready(NULL);
+    return NULL;
+}
+
+static void library_load_start(library_loader *l)
+{
+    if (!l->started)
+        l->started = start_thread(&l->thread, load_image_library, NULL) == 0;
+}
+
 /* The ray table is written on a thread of its own, and POV-Ray starts on each chunk as soon as
    it is complete; the image library (0.3 s to load) loads meanwhile. The --rays CSV is
    written in the workspace and handed to the user only when the render succeeds. */
@@ -170,6 +203,7 @@ typedef struct writer {
     pthread_mutex_t lock;
     int ready, total;          /* chunks complete; their count once done (-1 before) */
     int frames;                /* rendered through each chunk: one POV-Ray job a frame */
+    library_loader *library;   /* started with the first chunk: the writer's threads exist */
     atomic_bool stop;          /* from the renderer: stop at the next row */
     int status;
     l2p_error err;
@@ -207,19 +241,14 @@ static int chunks_ready(void *ctx, int *ready, int *total, l2p_error *err)
     writer *w = ctx;
     pthread_mutex_lock(&w->lock);
     *ready = w->ready * w->frames;   /* jobs are chunk-major: a chunk's frames together */
+    if (w->ready > 0)
+        library_load_start(w->library);   /* the runner calls this on the main thread */
     *total = w->total < 0 ? -1 : w->total * w->frames;
     const int st = w->status;
     if (st)
         *err = w->err;
     pthread_mutex_unlock(&w->lock);
     return st;
-}
-
-static void *load_image_library(void *arg)
-{
-    (void)arg;
-    image_io_ready(NULL);
-    return NULL;
 }
 
 static void free_chunk_list(povray_chunk *pc, int count)
@@ -317,23 +346,14 @@ static int publish_csv(const char *from, outfile *out, l2p_error *err)
     return outfile_commit(out, err);
 }
 
-/* Starts a thread with SIGINT, SIGTERM and SIGHUP blocked, so that they reach the main thread,
-   whose handler stops the POV-Ray processes it tracks. */
-static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
-{
-    sigset_t old;
-    cleanup_block_signals(&old);
-    const int r = pthread_create(t, NULL, fn, arg);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
-    return r;
-}
 
 /* Writes one table and renders its chunks for each of its frames side by side, then develops
    them. */
 static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
                             outfile *csv, const table_frames *tf, int table, l2p_error *err)
 {
-    writer w = {.cam = cam, .c = c, .total = -1, .frames = tf->count, .with_csv = table == 0};
+    writer w = {.cam = cam, .c = c, .total = -1, .frames = tf->count, .with_csv = table == 0,
+                .library = ws->library};
     if (table == 0)
         snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
     else
@@ -353,7 +373,9 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     int st = start_thread(&thread, write_table, &w) == 0
                  ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
     if (!st) {
-        st = image_io_ready(err);
+        /* The image library loads on a thread meanwhile: it must be there before POV-Ray runs
+           (a file check), and is waited for only to develop. */
+        st = image_io_present(err);
         /* Every process may use every core: the chunks cost the same to parse but not to shade
            (sky against floor), and a process left shading alone then gets the idle cores. */
         const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
@@ -367,6 +389,8 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         if (!st && w.status)   /* failed after its last chunk: the map or the CSV */
             st = l2p_fail(err, w.status, NULL, 0, "%s", w.err.text);
         if (!st)
+            st = image_io_ready(err);
+        if (!st)
             st = develop_frames(&w, pc, w.total, tf, err);
         if (!st && c->rays_csv && table == 0)
             st = publish_csv(w.csv, csv, err);
@@ -374,6 +398,11 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     pthread_mutex_destroy(&w.lock);
     free_chunk_list(pc, count * tf->count);
     return st;
+}
+
+static void start_library(void *loader)
+{
+    library_load_start(loader);
 }
 
 /* --sampling field: src/field does the rest for the table's frames, --rays included, which is
@@ -398,7 +427,7 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
     const field_render_options fo = {c->positional[0], ws->dir, prefix, fr, tf->count, tf->digits,
                                      c->povray_args, c->povray_arg_count, jobs, cores_online(),
                                      !c->quiet, c->field_tolerance, with_csv ? csv : NULL,
-                                     &too_fine};
+                                     &too_fine, start_library, ws->library};
     const int st = field_render(cam, &fo, err);
     free(fr);
     if (st == L2P_BAD_INPUT && too_fine && !c->sampling_chosen) {
@@ -470,9 +499,8 @@ int render_command(const cli *given, l2p_error *err)
         povargs_free(args);
         return st;
     }
-    pthread_t loader;
-    const bool loading = start_thread(&loader, load_image_library, NULL) == 0;
-    workspace w;
+    library_loader library = {.started = false};
+    workspace w = {.library = &library};
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
         !(st = make_workspace(&w, c, err))) {
@@ -486,7 +514,7 @@ int render_command(const cli *given, l2p_error *err)
     /* Joined, not detached: a render that fails early (a missing lens) must not exit while the
        loader is inside the libraries' start-up, nor before its thread-local data is freed
        (log4cplus, which OpenImageIO's DICOM reader loads, keeps some a thread). */
-    if (loading)
-        pthread_join(loader, NULL);
+    if (library.started)
+        pthread_join(library.thread, NULL);
     return st;
 }

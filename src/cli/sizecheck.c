@@ -88,9 +88,8 @@ static double field_subimage_faces(const cli *c, int w, int h, double coarsest)
 /* field_render packs consecutive sub-images into a render up to FIELD_FACES_PER_RENDER faces
    and at most spp / jobs (rounded up), at least one; no sub-image whose pixels all pass has
    fewer faces than the coarsest grid's two a cell, which bounds how many share a render. Its
-   picture, 2^a x 2^b as POV-Ray renders it, is chosen to waste the fewest pixels a sub-image,
-   one sub-image alone among the choices: so it has at most its sub-images' own renders'
-   pixels; every later render has the first one's size. */
+   picture, 2^a x 2^b, is never larger than its sub-images' own renders' pictures together;
+   every later render has the first one's size. */
 static field_layout field_layout_of(const cli *c, int jobs)
 {
     int w, h;

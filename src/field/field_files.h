@@ -12,6 +12,7 @@
 /* One POV-Ray render: its final size (POV-Ray renders one more each way) and sub-images. */
 typedef struct field_render_plan {
     int width, height;
+    int used_width, used_height;   /* the grid of sub-images, from the top left: rendered */
     int first, count;
     long long faces;
 } field_render_plan;

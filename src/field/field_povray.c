@@ -132,12 +132,12 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     int st = field_files_make(c, &q, &f, err);
     if (o->too_fine)
         *o->too_fine = f.too_fine;
-    /* the image library, loading on render's thread meanwhile: fail before POV-Ray runs when
-       it cannot be loaded, and never leave while it is half loaded */
-    l2p_error lib_err;
-    const int lib = image_io_ready(&lib_err);
-    if (!st && lib)
-        st = l2p_fail(err, lib, NULL, 0, "%s", lib_err.text);
+    if (!st && o->files_made)
+        o->files_made(o->files_ctx);
+    /* The image library loads on render's thread meanwhile: it must be there before POV-Ray
+       runs (a file check), and is waited for only to develop (render joins its loader). */
+    if (!st)
+        st = image_io_present(err);
     /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
     const povray_options po = {.scene_path = o->scene_path, .work_dir = o->work_dir,
                                .jobs = o->jobs, .threads_per_job = o->threads_per_job,
@@ -151,6 +151,8 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     if (!st)
         st = one_run_a_job ? render_by_jobs(&f, o->jobs, &po, err)
                            : povray_render_chunks(pc, f.renders * o->frame_count, &po, err);
+    if (!st)
+        st = image_io_ready(err);
     if (!st)
         st = develop_frames(&f, one_run_a_job ? f.chunk : pc, o, err);
     free_frame_chunks(pc, f.renders * o->frame_count);

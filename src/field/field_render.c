@@ -117,11 +117,13 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
 }
 
 /* Groups consecutive sub-images into renders: as many as the face budget takes, at most
-   most_per_render (so that every POV-Ray job gets a share). The first render takes the count
-   and grid whose render wastes the fewest pixels (its sides are 2^a - 1: every UV a short
-   binary fraction); every later one has its grid and size, with as many sub-images as the
-   budget and the grid take, since a POV-Ray process renders all its renders at one size
-   (assign_jobs). Returns the number of renders. */
+   most_per_render (so that every POV-Ray job gets an equal share). The first render takes the
+   largest count whose grid's picture (its sides 2^a - 1: every UV a short binary fraction) is
+   no larger than the count's lone sub-images' would be, in the grid of the smallest picture
+   (a power of two always has such a grid; POV-Ray renders only the grid, write_ini, so the
+   rest costs memory, not time); every later one has its grid and size, with as many
+   sub-images as the budget and the grid take, since a POV-Ray process renders all its renders
+   at one size (assign_jobs). Returns the number of renders. */
 static int pack(sub *subs, int spp, int w, int h, int most_per_render, field_render_plan *plans)
 {
     int renders = 0, grid_n = 1, grid_nx = 1;
@@ -134,12 +136,13 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, field_ren
             if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render ||
                           (renders > 0 && n > grid_n)))
                 break;
+            const double lone = (field_render_size(w) + 1.0) * (field_render_size(h) + 1.0);
             for (int nx = 1; nx <= n && renders == 0; nx++) {
                 int rw, rh;
                 grid_size(n, nx, w, h, &rw, &rh);
-                double cost = (double)(rw + 1) * (rh + 1) / n;
-                if (cost <= best)
-                    best = cost, best_n = n, best_nx = nx;
+                const double area = (rw + 1.0) * (rh + 1.0);
+                if (area <= n * lone && (n > best_n || area < best))
+                    best = area, best_n = n, best_nx = nx;
             }
             if (renders > 0)
                 best_n = n, best_nx = grid_nx;
@@ -148,6 +151,7 @@ static int pack(sub *subs, int spp, int w, int h, int most_per_render, field_ren
             grid_n = best_n, grid_nx = best_nx;
         field_render_plan *p = &plans[renders];
         grid_size(grid_n, grid_nx, w, h, &p->width, &p->height);
+        p->used_width = grid_nx * w, p->used_height = (grid_n + grid_nx - 1) / grid_nx * h;
         p->first = first, p->count = best_n, p->faces = 0;
         for (int i = 0; i < best_n; i++) {
             sub *s = &subs[first + i];
@@ -194,8 +198,9 @@ static int write_include(const camera *c, const sub *subs, const field_render_pl
     return st ? st : outfile_finish(f, err);
 }
 
-/* Its ini: (W+1) x (H+1) pixels, rows 2.. and columns ..W only (FS#261, docs/povray.md), the
-   picture named by its absolute path. */
+/* Its ini: (W+1) x (H+1) pixels, rows 2.. and columns ..W only (FS#261, docs/povray.md), and
+   of those only the grid's (POV-Ray still searches the faces for a pixel no face covers, at
+   about the cost of a pixel that one does), the picture named by its absolute path. */
 static int write_ini(const field_render_plan *p, const char *exr, outfile *f, l2p_error *err)
 {
     char *path = chunk_ini_absolute(exr);
@@ -208,9 +213,9 @@ static int write_ini(const field_render_plan *p, const char *exr, outfile *f, l2
     }
     const char *q = povray_ini_needs_quotes(path) ? "\"" : "";
     fprintf(f->fp, "; lens2pov: a ray-field render, final pixel (x, y) at image pixel (x, y + 1)\n"
-                   "Width=%d\nHeight=%d\nStart_Row=2\nEnd_Column=%d\nAntialias=Off\n"
+                   "Width=%d\nHeight=%d\nStart_Row=2\nEnd_Row=%d\nEnd_Column=%d\nAntialias=Off\n"
                    "Output_File_Type=E\nOutput_To_File=On\nOutput_File_Name=%s%s%s\nDisplay=Off\n",
-            p->width + 1, p->height + 1, p->width, q, path, q);
+            p->width + 1, p->height + 1, p->used_height + 1, p->used_width, q, path, q);
     free(path);
     return outfile_finish(f, err);
 }

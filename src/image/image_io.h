@@ -48,6 +48,11 @@ int image_get_attribute(const char *path, const char *name, char *buf, size_t le
    paths tried, as the other functions would fail. */
 int image_io_ready(l2p_error *err);
 
+/* Whether the image library is there to load, without loading it (a file check, at once):
+   render checks this before POV-Ray runs and waits for the load, which takes about 0.3 s,
+   only when it develops. L2P_FAILED with the paths tried, as image_io_ready. */
+int image_io_present(l2p_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -80,28 +80,41 @@ static bool try_load(const char *path)
     return true;
 }
 
-static void load_bridge(void)
+enum { CANDIDATES = 2 };
+
+/* The paths the library is looked for at, in order (see the top); the count, or 0 with *why
+   naming what went wrong. */
+static int candidates(char path[CANDIDATES][PATH_MAX + 64], const char **where, const char **why)
 {
     const char *forced = getenv("LENS2POV_IMAGE_IO");
     if (forced && *forced) {
+        *where = forced;
         /* dlopen would search its library path for a bare name: say so rather than guess. */
-        if (!strchr(forced, '/'))
-            note_failure(forced, "LENS2POV_IMAGE_IO must be a path, with a '/'");
-        else
-            try_load(forced);
-        return;
+        if (!strchr(forced, '/')) {
+            *why = "LENS2POV_IMAGE_IO must be a path, with a '/'";
+            return 0;
+        }
+        snprintf(path[0], sizeof path[0], "%s", forced);
+        return 1;
     }
-    char dir[PATH_MAX], path[PATH_MAX + 64];
-    const char *why;
-    if (!exe_dir(dir, sizeof dir, &why)) {
-        note_failure("/proc/self/exe", why);
-        return;
-    }
-    snprintf(path, sizeof path, "%s/" IMAGE_IO_LIBRARY, dir);
-    if (try_load(path))
-        return;
-    snprintf(path, sizeof path, "%s/../lib/lens2pov/" IMAGE_IO_LIBRARY, dir);
-    try_load(path);
+    char dir[PATH_MAX];
+    *where = "/proc/self/exe";
+    if (!exe_dir(dir, sizeof dir, why))
+        return 0;
+    snprintf(path[0], sizeof path[0], "%s/" IMAGE_IO_LIBRARY, dir);
+    snprintf(path[1], sizeof path[1], "%s/../lib/lens2pov/" IMAGE_IO_LIBRARY, dir);
+    return 2;
+}
+
+static void load_bridge(void)
+{
+    char path[CANDIDATES][PATH_MAX + 64];
+    const char *where, *why;
+    const int n = candidates(path, &where, &why);
+    if (n == 0)
+        note_failure(where, why);
+    for (int i = 0; i < n && !try_load(path[i]); i++)
+        continue;
 }
 
 /* Loads the library on the first call from any thread; L2P_FAILED (err set, when given) when it
@@ -117,6 +130,24 @@ static int bridge_ready(l2p_error *err)
 }
 
 int image_io_ready(l2p_error *err) { return bridge_ready(err); }
+
+int image_io_present(l2p_error *err)
+{
+    char path[CANDIDATES][PATH_MAX + 64], why[CANDIDATES * (PATH_MAX + 64 + 256) + 1024] = "";
+    const char *where, *reason;
+    const int n = candidates(path, &where, &reason);
+    if (n == 0)
+        snprintf(why, sizeof why, "%s (%s)", where, reason);
+    for (int i = 0; i < n; i++) {
+        if (access(path[i], R_OK) == 0)
+            return L2P_OK;
+        const size_t len = strlen(why);
+        snprintf(why + len, sizeof why - len, "%s%s (%s)", len ? "; " : "", path[i], strerror(errno));
+    }
+    return l2p_fail(err, L2P_FAILED, NULL, 0,
+                    "cannot load the image library " IMAGE_IO_LIBRARY " (OpenImageIO): tried %s",
+                    why);
+}
 
 int image_read_rgba(const char *path, int *width, int *height, float **pixels, l2p_error *err)
 {
