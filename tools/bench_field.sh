@@ -135,9 +135,10 @@ alone() {
 }
 # Sums over the runs of one sampling, less the baseline each: "PARSE_SECONDS PEAK_KB RUNS".
 runs_stats() {   # KEEP_DIR BASE_PARSE BASE_KB
-  for pov in "$1"/povray.c*.pov; do
-    ini=$(sed -n 's/^#include "\(.*\)\.inc"$/\1.ini/p' "$pov")
-    pov_stats "$ini" "$pov"
+  for inc in "$1"/rays.c*.inc "$1"/field.f*.inc; do
+    [ -f "$inc" ] || continue
+    printf '#include "%s"\n#include "%s"\n' "$work/light.pov" "$inc" >"$work/one.pov"
+    pov_stats "${inc%.inc}.ini" "$work/one.pov"
   done | awk -v bp="$2" -v bm="$3" '{ p += $1 - bp; m += $2 - bm; n++ } END { print p, m, n }'
 }
 faces() { cat "$1"/*.inc | grep -o 'face_indices { [0-9]*' | awk '{ n += $3 } END { print n }'; }
