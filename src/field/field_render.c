@@ -116,49 +116,93 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
     *rh = field_render_size((n + nx - 1) / nx * h);
 }
 
-/* Groups consecutive sub-images into renders: as many as the face budget takes, at most
-   most_per_render (so that every POV-Ray job gets an equal share). The first render takes the
-   largest count whose grid's picture (its sides 2^a - 1: every UV a short binary fraction) is
-   no larger than the count's lone sub-images' would be, in the grid of the smallest picture
-   (a power of two always has such a grid; POV-Ray renders only the grid, write_ini, so the
-   rest costs memory, not time); every later one has its grid and size, with as many
-   sub-images as the budget and the grid take, since a POV-Ray process renders all its renders
-   at one size (assign_jobs). Returns the number of renders. */
-static int pack(sub *subs, int spp, int w, int h, int most_per_render, field_render_plan *plans)
+/* Faces a render takes. Each render is a frame of a POV-Ray run, about FRAME_S of overhead;
+   POV-Ray's face search costs a pixel about SEARCH_S a face of its render (it scans the faces
+   in order up to the first that holds the pixel; docs/povray.md). Renders of B faces, of
+   sub-images of f faces and p pixels each, cost (spp f / B) FRAME_S + spp p SEARCH_S B, least
+   at B = sqrt(FRAME_S f / (p SEARCH_S)); at most FIELD_FACES_PER_RENDER. */
+#define FRAME_S 0.25
+#define SEARCH_S 4e-11
+
+static long long face_budget(const sub *subs, int spp, int w, int h)
 {
-    int renders = 0, grid_n = 1, grid_nx = 1;
+    double faces = 0;
+    for (int k = 0; k < spp; k++)
+        faces += subs[k].stats.faces;
+    const double f = fmax(1.0, faces / spp), b = sqrt(FRAME_S * f / ((double)w * h * SEARCH_S));
+    return (long long)fmin(b, FIELD_FACES_PER_RENDER);
+}
+
+/* The grid of n sub-images (its columns) with the smallest picture no larger than the n lone
+   sub-images' would be (its sides 2^a - 1: every UV a short binary fraction); 0 when none is.
+   A power of two always has one, and POV-Ray renders only the grid (write_ini): the rest of
+   the picture costs memory, not time. */
+static int grid_of(int n, int w, int h)
+{
+    const double lone = (field_render_size(w) + 1.0) * (field_render_size(h) + 1.0);
+    double best = INFINITY;
+    int best_nx = 0;
+    for (int nx = 1; nx <= n; nx++) {
+        int rw, rh;
+        grid_size(n, nx, w, h, &rw, &rh);
+        const double area = (rw + 1.0) * (rh + 1.0);
+        if (area <= n * lone && area < best)
+            best = area, best_nx = nx;
+    }
+    return best_nx;
+}
+
+/* How many renders: as many as a render's count allows, the largest that face_budget and an
+   equal share for every job take (of the first sub-images) and that has a grid; at least as
+   many as the budget needs on average; a multiple of the jobs, so that the jobs get equal
+   shares. */
+static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long budget)
+{
+    const int most = (spp + jobs - 1) / jobs;
+    long long faces = 0, all = 0;
+    int count = 1;
+    for (int n = 1; n <= spp; n++) {
+        faces += subs[n - 1].stats.faces;
+        if (n > 1 && (faces > budget || n > most))
+            break;
+        if (grid_of(n, w, h))
+            count = n;
+    }
+    for (int k = 0; k < spp; k++)
+        all += subs[k].stats.faces;
+    long long renders = (spp + count - 1) / count;
+    if (renders < (all + budget - 1) / budget)
+        renders = (all + budget - 1) / budget;
+    renders = (renders + jobs - 1) / jobs * jobs;
+    return (int)(renders < spp ? renders : spp);
+}
+
+/* Groups consecutive sub-images into renders, spread evenly over render_count of them, all
+   with one grid and size since a POV-Ray process renders all its renders at one size
+   (assign_jobs); a render holds at most FIELD_FACES_PER_RENDER faces, or one sub-image (more
+   renders then follow). Returns the number of renders. */
+static int pack(sub *subs, int spp, int w, int h, int jobs, field_render_plan *plans)
+{
+    const int even = render_count(subs, spp, w, h, jobs, face_budget(subs, spp, w, h));
+    const int grid_n = (spp + even - 1) / even;
+    int grid_nx = grid_of(grid_n, w, h);
+    if (!grid_nx)   /* fewer than a count that has a grid: the shortest row */
+        grid_nx = grid_n;
+    int renders = 0;
     for (int first = 0; first < spp; renders++) {
-        double best = INFINITY;
-        int best_n = 1, best_nx = 1;
-        long long faces = 0;
-        for (int n = 1; first + n <= spp; n++) {
-            faces += subs[first + n - 1].stats.faces;
-            if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most_per_render ||
-                          (renders > 0 && n > grid_n)))
-                break;
-            const double lone = (field_render_size(w) + 1.0) * (field_render_size(h) + 1.0);
-            for (int nx = 1; nx <= n && renders == 0; nx++) {
-                int rw, rh;
-                grid_size(n, nx, w, h, &rw, &rh);
-                const double area = (rw + 1.0) * (rh + 1.0);
-                if (area <= n * lone && (n > best_n || area < best))
-                    best = area, best_n = n, best_nx = nx;
-            }
-            if (renders > 0)
-                best_n = n, best_nx = grid_nx;
-        }
-        if (renders == 0)
-            grid_n = best_n, grid_nx = best_nx;
+        const int target = spp / even + (renders < spp % even);
+        long long faces = subs[first].stats.faces;
+        int n = 1;
+        while (n < target && first + n < spp &&
+               faces + subs[first + n].stats.faces <= FIELD_FACES_PER_RENDER)
+            faces += subs[first + n++].stats.faces;
         field_render_plan *p = &plans[renders];
         grid_size(grid_n, grid_nx, w, h, &p->width, &p->height);
         p->used_width = grid_nx * w, p->used_height = (grid_n + grid_nx - 1) / grid_nx * h;
-        p->first = first, p->count = best_n, p->faces = 0;
-        for (int i = 0; i < best_n; i++) {
-            sub *s = &subs[first + i];
-            s->at = (field_placement){renders, i % best_nx * w, i / best_nx * h};
-            p->faces += s->stats.faces;
-        }
-        first += best_n;
+        p->first = first, p->count = n, p->faces = faces;
+        for (int i = 0; i < n; i++)
+            subs[first + i].at = (field_placement){renders, i % grid_nx * w, i / grid_nx * h};
+        first += n;
     }
     return renders;
 }
@@ -320,7 +364,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
         st = build_all(&j, jobs, err);
     out->too_fine = st && j.too_fine;
     pthread_mutex_destroy(&j.lock);
-    const int renders = st ? 0 : pack(subs, spp, w, h, (spp + jobs - 1) / jobs, plans);
+    const int renders = st ? 0 : pack(subs, spp, w, h, jobs, plans);
     if (!st)
         st = finish_map(c, subs, plans, renders, &out->map, err);
     if (!st)
