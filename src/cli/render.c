@@ -24,6 +24,7 @@
 #include "raytable/chunk_name.h"
 #include "base/tempdir.h"
 #include "cli/sizecheck.h"
+#include "cli/workspace.h"
 #include "field/field_render.h"
 #include "raytable/raytable.h"
 
@@ -95,76 +96,6 @@ typedef struct library_loader {
     pthread_t thread;
     bool started;
 } library_loader;
-
-typedef struct workspace {
-    char dir[4096];
-    bool keep;
-    library_loader *library;
-} workspace;
-
-static void remove_workspace(const workspace *w);
-
-/* Workspaces are named lens2pov.PID.XXXXXX. One whose process is gone (killed with SIGKILL,
-   which no handler sees) is removed by the next render that looks in the same folder, when it
-   is ours: so they never pile up. A process id taken again by another process keeps its
-   folder until that one ends too. */
-static void remove_stale_workspaces(const char *tmp)
-{
-    DIR *d = opendir(tmp);
-    if (!d)
-        return;
-    for (struct dirent *e; (e = readdir(d)) != NULL;) {
-        long pid;
-        char rest[16];
-        if (sscanf(e->d_name, "lens2pov.%ld.%15s", &pid, rest) != 2 || strlen(rest) != 6 ||
-            pid <= 0 || (kill((pid_t)pid, 0) == 0 || errno != ESRCH))
-            continue;
-        workspace stale = {.keep = false};
-        struct stat sb;
-        snprintf(stale.dir, sizeof stale.dir, "%s/%s", tmp, e->d_name);
-        if (lstat(stale.dir, &sb) == 0 && S_ISDIR(sb.st_mode) && sb.st_uid == getuid())
-            remove_workspace(&stale);
-    }
-    closedir(d);
-}
-
-static int make_workspace(workspace *w, const cli *c, l2p_error *err)
-{
-    w->keep = c->keep_temp != NULL;
-    if (w->keep) {
-        snprintf(w->dir, sizeof w->dir, "%s", c->keep_temp);
-        if (mkdir(w->dir, 0777) != 0 && errno != EEXIST)
-            return l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "cannot make folder: %s", strerror(errno));
-        return L2P_OK;
-    }
-    const char *tmp = temp_root();
-    remove_stale_workspaces(tmp);
-    snprintf(w->dir, sizeof w->dir, "%s/lens2pov.%ld.XXXXXX", tmp, (long)getpid());
-    if (!mkdtemp(w->dir))
-        return l2p_fail(err, L2P_FAILED, w->dir, 0, "cannot make a temporary folder: %s",
-                        strerror(errno));
-    cleanup_track(w->dir);
-    return L2P_OK;
-}
-
-/* Removes the workspace and its files (nothing in it has folders). */
-static void remove_workspace(const workspace *w)
-{
-    if (w->keep)
-        return;
-    DIR *d = opendir(w->dir);
-    if (d) {
-        char path[8192];
-        for (struct dirent *e; (e = readdir(d)) != NULL;)
-            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-                snprintf(path, sizeof path, "%s/%s", w->dir, e->d_name);
-                unlink(path);
-            }
-        closedir(d);
-    }
-    rmdir(w->dir);
-    cleanup_untrack(w->dir);
-}
 
 /* Starts a thread with SIGINT, SIGTERM and SIGHUP blocked, so that they reach the main thread,
    whose handler stops the POV-Ray processes it tracks. */
@@ -503,10 +434,10 @@ int render_command(const cli *given, l2p_error *err)
     workspace w = {.library = &library};
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
-        !(st = make_workspace(&w, c, err))) {
+        !(st = workspace_make(&w, c->keep_temp, err))) {
         for (int t = 0; !st && t < rf.tables; t++)
             st = render_table(&rf, t, &w, jobs, &csv, err);
-        remove_workspace(&w);
+        workspace_remove(&w);
     }
     outfile_discard(&csv);   /* nothing when committed */
     render_frames_free(&rf);
