@@ -82,14 +82,7 @@ Test(sizecheck, a_field_render_stays_within_its_estimate)
     memcpy(argv + 1, args, sizeof args);
     char *errtext = NULL;
     record_povray_peaks(dir);
-#ifdef __SANITIZE_ADDRESS__
-    /* LeakSanitizer's tracer crashes at the exit of this render every time (google/sanitizers
-       #1353, OpenImageIO's threads alive at exit): its leaks are checked by the other field
-       renders of the suite, its estimate here. */
-    setenv("LSAN_OPTIONS", "detect_leaks=0", 1);
-#endif
     const int st = run_lens2pov_argv(NULL, &errtext, argv);
-    unsetenv("LSAN_OPTIONS");
     unsetenv("LENS2POV_POVRAY");
     cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
     free(errtext);

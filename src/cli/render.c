@@ -89,14 +89,6 @@ static long long chunk_faces_for(const camera *cam, const cli *c, int jobs, int 
     return per_chunk > 0 ? per_chunk : 1;
 }
 
-/* The image library (about 0.3 s of dlopen) loads on a thread of its own while POV-Ray runs.
-   It is started once the trace's threads exist: while dlopen holds the dynamic loader's lock,
-   glibc's pthread_create waits for it, and the trace waited out the whole load. */
-typedef struct library_loader {
-    pthread_t thread;
-    bool started;
-} library_loader;
-
 /* Starts a thread with SIGINT, SIGTERM and SIGHUP blocked, so that they reach the main thread,
    whose handler stops the POV-Ray processes it tracks. */
 static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
@@ -108,17 +100,16 @@ static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
     return r;
 }
 
-static void *load_image_library(void *arg)
+/* The image library (about 0.3 s of dlopen) loads on the main thread once the first POV-Ray
+   processes run (povray_options.started), mostly while they start up. Not on a thread of its
+   own: while dlopen held the dynamic loader's lock, glibc's pthread_create waited for it (the
+   trace's threads waited out the whole load), and under LeakSanitizer a main thread whose
+   libraries another thread had loaded held a dynamic TLS block the leak scan crashed on. Its
+   failure is reported when develop needs it. */
+static void load_image_library(void *unused)
 {
-    (void)arg;
+    (void)unused;
     image_io_ready(NULL);
-    return NULL;
-}
-
-static void library_load_start(library_loader *l)
-{
-    if (!l->started)
-        l->started = start_thread(&l->thread, load_image_library, NULL) == 0;
 }
 
 /* The ray table is written on a thread of its own, and POV-Ray starts on each chunk as soon as
@@ -134,7 +125,6 @@ typedef struct writer {
     pthread_mutex_t lock;
     int ready, total;          /* chunks complete; their count once done (-1 before) */
     int frames;                /* rendered through each chunk: one POV-Ray job a frame */
-    library_loader *library;   /* started with the first chunk: the writer's threads exist */
     atomic_bool stop;          /* from the renderer: stop at the next row */
     int status;
     l2p_error err;
@@ -172,8 +162,6 @@ static int chunks_ready(void *ctx, int *ready, int *total, l2p_error *err)
     writer *w = ctx;
     pthread_mutex_lock(&w->lock);
     *ready = w->ready * w->frames;   /* jobs are chunk-major: a chunk's frames together */
-    if (w->ready > 0)
-        library_load_start(w->library);   /* the runner calls this on the main thread */
     *total = w->total < 0 ? -1 : w->total * w->frames;
     const int st = w->status;
     if (st)
@@ -283,8 +271,7 @@ static int publish_csv(const char *from, outfile *out, l2p_error *err)
 static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
                             outfile *csv, const table_frames *tf, int table, l2p_error *err)
 {
-    writer w = {.cam = cam, .c = c, .total = -1, .frames = tf->count, .with_csv = table == 0,
-                .library = ws->library};
+    writer w = {.cam = cam, .c = c, .total = -1, .frames = tf->count, .with_csv = table == 0};
     if (table == 0)
         snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
     else
@@ -304,14 +291,15 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     int st = start_thread(&thread, write_table, &w) == 0
                  ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
     if (!st) {
-        /* The image library loads on a thread meanwhile: it must be there before POV-Ray runs
-           (a file check), and is waited for only to develop. */
+        /* The image library must be there before POV-Ray runs (a file check); it loads once
+           POV-Ray runs. */
         st = image_io_present(err);
         /* Every process may use every core: the chunks cost the same to parse but not to shade
            (sky against floor), and a process left shading alone then gets the idle cores. */
         const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
                                    !c->quiet, NULL, chunks_ready, &w, c->povray_args,
-                                   c->povray_arg_count, c->cam.width, c->cam.height};
+                                   c->povray_arg_count, c->cam.width, c->cam.height,
+                                   load_image_library, NULL};
         if (!st)
             st = povray_render_chunks(pc, count * tf->count, &po, err);
         if (st)
@@ -329,11 +317,6 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     pthread_mutex_destroy(&w.lock);
     free_chunk_list(pc, count * tf->count);
     return st;
-}
-
-static void start_library(void *loader)
-{
-    library_load_start(loader);
 }
 
 /* --sampling field: src/field does the rest for the table's frames, --rays included, which is
@@ -358,7 +341,7 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
     const field_render_options fo = {c->positional[0], ws->dir, prefix, fr, tf->count, tf->digits,
                                      c->povray_args, c->povray_arg_count, jobs, cores_online(),
                                      !c->quiet, c->field_tolerance, with_csv ? csv : NULL,
-                                     &too_fine, start_library, ws->library};
+                                     &too_fine, load_image_library};
     const int st = field_render(cam, &fo, err);
     free(fr);
     if (st == L2P_BAD_INPUT && too_fine && !c->sampling_chosen) {
@@ -430,8 +413,7 @@ int render_command(const cli *given, l2p_error *err)
         povargs_free(args);
         return st;
     }
-    library_loader library = {.started = false};
-    workspace w = {.library = &library};
+    workspace w;
     outfile csv = {0};
     if (!(st = c->rays_csv ? outfile_open(&csv, c->rays_csv, err) : L2P_OK) &&
         !(st = workspace_make(&w, c->keep_temp, err))) {
@@ -442,10 +424,5 @@ int render_command(const cli *given, l2p_error *err)
     outfile_discard(&csv);   /* nothing when committed */
     render_frames_free(&rf);
     povargs_free(args);
-    /* Joined, not detached: a render that fails early (a missing lens) must not exit while the
-       loader is inside the libraries' start-up, nor before its thread-local data is freed
-       (log4cplus, which OpenImageIO's DICOM reader loads, keeps some a thread). */
-    if (library.started)
-        pthread_join(library.thread, NULL);
     return st;
 }

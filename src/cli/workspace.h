@@ -6,12 +6,9 @@
 #include <stdbool.h>
 #include "base/error.h"
 
-struct library_loader;
-
 typedef struct workspace {
     char dir[4096];
-    bool keep;                        /* --keep-temp's folder: left in place */
-    struct library_loader *library;   /* render's image library loader (render.c) */
+    bool keep;                 /* --keep-temp's folder: left in place */
 } workspace;
 
 /* keep (--keep-temp), made when missing; else a new lens2pov.PID.XXXXXX in the temporary

@@ -132,10 +132,8 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     int st = field_files_make(c, &q, &f, err);
     if (o->too_fine)
         *o->too_fine = f.too_fine;
-    if (!st && o->files_made)
-        o->files_made(o->files_ctx);
-    /* The image library loads on render's thread meanwhile: it must be there before POV-Ray
-       runs (a file check), and is waited for only to develop (render joins its loader). */
+    /* The image library must be there before POV-Ray runs (a file check); render loads it
+       once POV-Ray runs (povray_started). */
     if (!st)
         st = image_io_present(err);
     /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
@@ -143,6 +141,7 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                .jobs = o->jobs, .threads_per_job = o->threads_per_job,
                                .show_progress = o->progress, .user_args = o->povray_args,
                                .user_arg_count = o->povray_arg_count,
+                               .started = o->povray_started,
                                .film_width = c->film.width, .film_height = c->film.height};
     const bool one_run_a_job = !o->povray_args && o->frame_count == 1 && o->frames[0].number < 0;
     povray_chunk *pc = st || one_run_a_job ? NULL : frame_chunks(&f, o);

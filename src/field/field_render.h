@@ -35,9 +35,7 @@ typedef struct field_render_options {
     bool *too_fine;            /* set when the failure is a sub-image the tolerance cannot
                                   draw (more faces than pixels, or finer than float32);
                                   NULL: not asked */
-    void (*files_made)(void *ctx);   /* called once the files are made, before POV-Ray runs,
-                                        with files_ctx; NULL: none */
-    void *files_ctx;
+    void (*povray_started)(void *ctx);   /* povray_options.started's, with no context */
 } field_render_options;
 
 /* --field-tolerance's default, in pixels: no picture shows an error this small. */

@@ -291,12 +291,17 @@ static int poll_chunks(run *r, int *ready, l2p_error *err)
 static int schedule(run *r, l2p_error *err)
 {
     int next = 0, finished = 0, chunks_done = 0, ready = 0, st = L2P_OK;
+    bool told = !r->opts->started;
     for (int tick = 0; !st && finished < r->tasks; tick++) {
         st = poll_chunks(r, &ready, err);
         for (int i = 0; i < r->job_slots && next < r->tasks && !st &&
                         task_first(r, next) + task_chunks(r, next) <= ready; i++)
             if (!r->jobs[i].pid)
                 st = start_job(r, &r->jobs[i], next++, err);
+        if (!st && next > 0 && !told) {
+            told = true;
+            r->opts->started(r->opts->started_ctx);
+        }
         const int ended = st ? 0 : reap_jobs(r, &chunks_done, &st, err);
         finished += ended;
         if (ended || st)

@@ -47,6 +47,10 @@ typedef struct povray_options {
     char *const *user_args;    /* POV-Ray's own options from the command line, before ours */
     int user_arg_count;
     int film_width, film_height;   /* image_width, image_height in the scene; 0: not declared */
+    /* Called once on the calling thread, with started_ctx, as soon as the first POV-Ray
+       processes run (work that can overlap their start-up); NULL: none. */
+    void (*started)(void *ctx);
+    void *started_ctx;
 } povray_options;
 
 /* Writes, for every chunk, a wrapper that includes the scene and then the chunk's camera, and
