@@ -138,13 +138,22 @@ Test(emit, crop_traces_exactly_the_samples_of_its_region)
     free(crop);
 }
 
-/* The film centre's mean weight, counting blocked samples as 0, is 1 when normalized. */
+/* The film centre's mean weight, counting blocked samples as 0, is 1 when normalized. Under
+   AddressSanitizer, which traces a ray some fifty times slower, a 256 x 256
+   grid and its tolerance: the memory checks see the same code, the normal build the 0.4%. */
+#ifdef __SANITIZE_ADDRESS__
+enum { N = 256 };
+static const double TOLERANCE = 0.012;
+#else
+enum { N = 1000 };
+static const double TOLERANCE = 0.004;
+#endif
+
 Test(emit, normalized_weights_average_one_at_the_centre)
 {
     for (int p = 0; p < 3; p++) {
         camera c;
         camera_for("dgauss.50mm", PUPILS[p], &c);
-        enum { N = 1000 };
         double sum = 0;
         for (int j = 0; j < N; j++)
             for (int i = 0; i < N; i++) {
@@ -156,7 +165,8 @@ Test(emit, normalized_weights_average_one_at_the_centre)
         /* An independent estimate: a 1000 x 1000 grid over the pupil, against the exact cone
            integral the camera normalizes with. The grid's error at the edge of the passing
            region is first order, about 0.1% here (0.6% at 256 x 256). */
-        cr_assert_float_eq(sum / ((double)N * N), 1.0, 0.004, "%s: %g", PUPILS[p], sum / ((double)N * N));
+        cr_assert_float_eq(sum / ((double)N * N), 1.0, TOLERANCE, "%s: %g", PUPILS[p],
+                           sum / ((double)N * N));
         camera_free(&c);
     }
 }
