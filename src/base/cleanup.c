@@ -1,3 +1,5 @@
+/* _Fork (glibc 2.34), for the signal handler. */
+#define _GNU_SOURCE
 #include "base/cleanup.h"
 
 #include <signal.h>
@@ -51,13 +53,14 @@ void cleanup_untrack_child(pid_t pid)
             children[i] = 0;
 }
 
-/* A folder, with whatever is in it, goes through rm -rf in a child process: fork, execve and
-   waitpid are async-signal-safe, readdir is not. */
+/* A folder, with whatever is in it, goes through rm -rf in a child process: _Fork, execve and
+   waitpid are async-signal-safe, readdir is not. Not fork: glibc's takes malloc's locks, and a
+   signal that came inside malloc (dlopen of the image library, on this thread) deadlocked. */
 static void remove_path(const char *path)
 {
     if (unlink(path) == 0 || rmdir(path) == 0)
         return;
-    pid_t pid = fork();
+    pid_t pid = _Fork();
     if (pid == 0) {
         char *const argv[] = {"rm", "-rf", "--", (char *)path, NULL};
         char *const envp[] = {NULL};

@@ -124,13 +124,11 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
 #define FRAME_S 0.25
 #define SEARCH_S 4e-11
 
-static long long face_budget(const sub *subs, int spp, int w, int h)
+static long long face_budget(long long faces, int spp, int w, int h)
 {
-    double faces = 0;
-    for (int k = 0; k < spp; k++)
-        faces += subs[k].stats.faces;
-    const double f = fmax(1.0, faces / spp), b = sqrt(FRAME_S * f / ((double)w * h * SEARCH_S));
-    return (long long)fmin(b, FIELD_FACES_PER_RENDER);
+    const double f = fmax(1.0, (double)faces / spp);
+    const double b = sqrt(FRAME_S * f / ((double)w * h * SEARCH_S));
+    return (long long)fmax(1.0, fmin(b, FIELD_FACES_PER_RENDER));
 }
 
 /* The grid of n sub-images (its columns) with the smallest picture no larger than the n lone
@@ -156,10 +154,11 @@ static int grid_of(int n, int w, int h)
    equal share for every job take (of the first sub-images) and that has a grid; at least as
    many as the budget needs on average; a multiple of the jobs, so that the jobs get equal
    shares. */
-static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long budget)
+static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long all)
 {
+    const long long budget = face_budget(all, spp, w, h);
     const int most = (spp + jobs - 1) / jobs;
-    long long faces = 0, all = 0;
+    long long faces = 0;
     int count = 1;
     for (int n = 1; n <= spp; n++) {
         faces += subs[n - 1].stats.faces;
@@ -168,8 +167,6 @@ static int render_count(const sub *subs, int spp, int w, int h, int jobs, long l
         if (grid_of(n, w, h))
             count = n;
     }
-    for (int k = 0; k < spp; k++)
-        all += subs[k].stats.faces;
     long long renders = (spp + count - 1) / count;
     if (renders < (all + budget - 1) / budget)
         renders = (all + budget - 1) / budget;
@@ -183,7 +180,10 @@ static int render_count(const sub *subs, int spp, int w, int h, int jobs, long l
    renders then follow). Returns the number of renders. */
 static int pack(sub *subs, int spp, int w, int h, int jobs, field_render_plan *plans)
 {
-    const int even = render_count(subs, spp, w, h, jobs, face_budget(subs, spp, w, h));
+    long long all = 0;
+    for (int k = 0; k < spp; k++)
+        all += subs[k].stats.faces;
+    const int even = render_count(subs, spp, w, h, jobs, all);
     const int grid_n = (spp + even - 1) / even;
     int grid_nx = grid_of(grid_n, w, h);
     if (!grid_nx)   /* fewer than a count that has a grid: the shortest row */

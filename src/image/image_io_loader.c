@@ -117,16 +117,19 @@ static void load_bridge(void)
         continue;
 }
 
+static int cannot_load(l2p_error *err, const char *tried)
+{
+    return l2p_fail(err, L2P_FAILED, NULL, 0,
+                    "cannot load the image library " IMAGE_IO_LIBRARY " (OpenImageIO): tried %s",
+                    tried);
+}
+
 /* Loads the library on the first call from any thread; L2P_FAILED (err set, when given) when it
    cannot be loaded. */
 static int bridge_ready(l2p_error *err)
 {
     pthread_once(&bridge_once, load_bridge);
-    if (bridge.read_rgba)
-        return L2P_OK;
-    return l2p_fail(err, L2P_FAILED, NULL, 0,
-                    "cannot load the image library " IMAGE_IO_LIBRARY " (OpenImageIO): tried %s",
-                    bridge.why);
+    return bridge.read_rgba ? L2P_OK : cannot_load(err, bridge.why);
 }
 
 int image_io_ready(l2p_error *err) { return bridge_ready(err); }
@@ -144,9 +147,7 @@ int image_io_present(l2p_error *err)
         const size_t len = strlen(why);
         snprintf(why + len, sizeof why - len, "%s%s (%s)", len ? "; " : "", path[i], strerror(errno));
     }
-    return l2p_fail(err, L2P_FAILED, NULL, 0,
-                    "cannot load the image library " IMAGE_IO_LIBRARY " (OpenImageIO): tried %s",
-                    why);
+    return cannot_load(err, why);
 }
 
 int image_read_rgba(const char *path, int *width, int *height, float **pixels, l2p_error *err)
