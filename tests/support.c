@@ -153,9 +153,8 @@ char *read_text(const char *path, size_t *length)
 /* LeakSanitizer's stop-the-world tracer sometimes crashes at exit of a process that had
    threads (google/sanitizers#1353): the run itself finished, but its status is LSan's. Only
    that exact message, without a leak report, is taken for the sanitizer's failure, and the
-   run is made again up to LSAN_RETRIES times. (The crashes that came every time, at the exit
-   of some field renders, were a dynamic TLS block of the main thread whose libraries another
-   thread had loaded: render now loads the image library on its main thread, render.c.) */
+   run is made again up to LSAN_RETRIES times. (The crashes that came on every retry were
+   another fault, avoided by make test-sanitize's ASAN_OPTIONS: docs/testing.md.) */
 enum { LSAN_RETRIES = 6 };
 static bool lsan_crashed(const char *errtext)
 {

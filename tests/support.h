@@ -13,6 +13,15 @@
 #endif
 #define LENS_DIR LENS2POV_SOURCE_DIR "/lenses/"
 
+/* A reference grid's density: FULL in the normal build; under AddressSanitizer, where a ray
+   costs some fifty times more, the coarser ASAN (the memory checks see the same code; the
+   normal build holds the fine tolerance). */
+#ifdef __SANITIZE_ADDRESS__
+#define FULL_OR_ASAN(full, asan) (asan)
+#else
+#define FULL_OR_ASAN(full, asan) (full)
+#endif
+
 /* Runs the lens2pov binary ($LENS2POV, else build/lens2pov) with a NULL-terminated argument
    list; stdout and stderr go to files that *out and *errout receive (malloc'd, may be NULL).
    Returns the exit status. */

@@ -138,16 +138,10 @@ Test(emit, crop_traces_exactly_the_samples_of_its_region)
     free(crop);
 }
 
-/* The film centre's mean weight, counting blocked samples as 0, is 1 when normalized. Under
-   AddressSanitizer, which traces a ray some fifty times slower, a 256 x 256
-   grid and its tolerance: the memory checks see the same code, the normal build the 0.4%. */
-#ifdef __SANITIZE_ADDRESS__
-enum { N = 256 };
-static const double TOLERANCE = 0.012;
-#else
-enum { N = 1000 };
-static const double TOLERANCE = 0.004;
-#endif
+/* The film centre's mean weight, counting blocked samples as 0, is 1 when normalized; under
+   AddressSanitizer on a 256 x 256 grid, with that grid's tolerance (FULL_OR_ASAN). */
+enum { N = FULL_OR_ASAN(1000, 256) };
+static const double TOLERANCE = FULL_OR_ASAN(0.004, 0.012);
 
 Test(emit, normalized_weights_average_one_at_the_centre)
 {

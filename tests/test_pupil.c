@@ -248,9 +248,10 @@ static long count_cells(const lens *l, vec3 p, double x0, double y0, double h, i
    a grid of half the density gives the error estimate *error. */
 static double irradiance(const lens *l, vec3 p, int n, double *error)
 {
-    const double coarse = 1.0 / 512;
+    const int steps = FULL_OR_ASAN(1024, 512);
+    const double coarse = 2.0 / steps;
     double box[4] = {1, -1, 1, -1};
-    if (count_cells(l, p, -1.0, -1.0, coarse, 1024, box) == 0) {
+    if (count_cells(l, p, -1.0, -1.0, coarse, steps, box) == 0) {
         *error = 0.0;
         return 0.0;
     }
@@ -288,7 +289,10 @@ static double estimate(const camera *c, vec3 p, int side, double *std_error)
    fisheye to f/4; f/64 stands for the small stops), at the centre, mid-field, mid-edge and
    corner; beyond the fisheye's image circle both are 0. The tolerance: four standard errors
    of the 128 x 128 samples (0.1-0.5%), plus twice the grid's own error (its change from half
-   the density), plus 2e-4 of the value for the rest of the grid's discretization. */
+   the density), plus 2e-4 of the value for the rest of the grid's discretization. (Under
+   AddressSanitizer, 64 x 64 samples and a grid of half the density: FULL_OR_ASAN.) */
+enum { SIDE = FULL_OR_ASAN(128, 64), GRID = FULL_OR_ASAN(512, 256) };
+
 Test(pupil, irradiance_matches_an_independent_integral_over_the_lens)
 {
     const double f_numbers[] = {NAN, 8.0, 16.0, 64.0};
@@ -299,8 +303,8 @@ Test(pupil, irradiance_matches_an_independent_integral_over_the_lens)
             for (int i = 0; i < POINTS; i++) {
                 const vec3 p = film_point(&c, i);
                 double se, grid_error;
-                const double got = estimate(&c, p, 128, &se);
-                const double want = irradiance(&c.lens, p, 512, &grid_error);
+                const double got = estimate(&c, p, SIDE, &se);
+                const double want = irradiance(&c.lens, p, GRID, &grid_error);
                 const double tolerance = 4.0 * se + 2.0 * grid_error + 2e-4 * want;
                 cr_assert(fabs(got - want) <= tolerance,
                           "%s f/%g, film (%.2f, %.2f): lens2pov %.6g, the lens passes %.6g "
@@ -326,8 +330,8 @@ Test(pupil, irradiance_through_blades_matches_an_independent_integral)
                 for (int i = 0; i < POINTS; i++) {
                     const vec3 p = film_point(&c, i);
                     double se, grid_error;
-                    const double got = estimate(&c, p, 128, &se);
-                    const double want = irradiance(&c.lens, p, 512, &grid_error);
+                    const double got = estimate(&c, p, SIDE, &se);
+                    const double want = irradiance(&c.lens, p, GRID, &grid_error);
                     const double tolerance = 4.0 * se + 2.0 * grid_error + 2e-4 * want;
                     cr_assert(fabs(got - want) <= tolerance,
                               "%s f/%g, %d blades, film (%.2f, %.2f): lens2pov %.6g, the lens "
@@ -348,7 +352,7 @@ Test(pupil, irradiance_through_blades_matches_an_independent_integral)
 Test(pupil, every_passing_ray_lies_in_the_sampled_region)
 {
     const double openings[] = {1.0, 0.25, 1.0 / 16};
-    enum { N = 300 };
+    enum { N = FULL_OR_ASAN(300, 120) };
     for (int li = 0; li < 4; li++)
         for (int oi = 0; oi < 3; oi++)
             for (int fi = 0; fi < 2; fi++)

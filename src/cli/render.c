@@ -101,9 +101,7 @@ static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
 /* The image library (about 0.3 s of dlopen) loads on the main thread once the first POV-Ray
    processes run (povray_options.started), mostly while they start up. Not on a thread of its
    own: while dlopen held the dynamic loader's lock, glibc's pthread_create waited for it (the
-   trace's threads waited out the whole load), and under LeakSanitizer a main thread whose
-   libraries another thread had loaded held a dynamic TLS block the leak scan crashed on. Its
-   failure is reported when develop needs it. */
+   trace's threads waited out the whole load). Its failure is reported when develop needs it. */
 static void load_image_library(void *unused)
 {
     (void)unused;
