@@ -173,9 +173,9 @@ Test(field, a_crop_every_pixel_within_the_tolerance)
     check_subimage("fisheye.10mm", &o, 0.05, 2, &st);
 }
 
-/* Two sub-images moved side by side into one render (as field_render.c packs them): read back
-   through the model, every pixel of each still gets its exact ray within the tolerance, and
-   the pixels between and beyond them none. */
+/* Two sub-images moved side by side into one render and their faces put largest first (as
+   field_render.c writes them): read back through the model, every pixel of each still gets its
+   exact ray within the tolerance, and the pixels between and beyond them none. */
 Test(field, sub_images_moved_into_a_render_keep_their_rays)
 {
     camera_options o = small(120, 90);
@@ -197,6 +197,7 @@ Test(field, sub_images_moved_into_a_render_keep_their_rays)
         cr_assert_eq(field_mesh_append(&render, &m, dx[k], 0), 0);
         field_mesh_free(&m);
     }
+    cr_assert_eq(field_mesh_sort_faces_by_area(&render), 0);
     char *text = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);
@@ -237,4 +238,24 @@ Test(field, sub_images_moved_into_a_render_keep_their_rays)
     povuv_mesh_free(&pm);
     field_mesh_free(&render);
     camera_free(&c);
+}
+
+/* Sorting keeps every face (its three vertices in their order) and puts them largest first. */
+Test(field, faces_sorted_largest_first_are_the_same_faces)
+{
+    field_mesh m;
+    field_mesh_init(&m, 63, 63);
+    const double at[6][2] = {{0, 0}, {1, 0}, {0, 1}, {8, 0}, {0, 8}, {3, 4}};
+    for (int i = 0; i < 6; i++)
+        cr_assert_geq(field_mesh_vertex(&m, v3(i, 0, 0), v3(0, 0, 1), at[i][0], at[i][1]), 0);
+    const int tri[4][3] = {{0, 1, 2}, {0, 3, 4}, {1, 5, 2}, {3, 5, 4}};
+    for (int k = 0; k < 4; k++)
+        cr_assert_geq(field_mesh_face(&m, tri[k][0], tri[k][1], tri[k][2]), 0);
+    cr_assert_eq(field_mesh_sort_faces_by_area(&m), 0);
+    /* twice the areas: 1, 64, 6, 8 (the shoelace formula by hand) */
+    const int want[4] = {1, 3, 2, 0};
+    for (int k = 0; k < 4; k++)
+        for (int j = 0; j < 3; j++)
+            cr_assert_eq(m.tri[k][j], tri[want[k]][j], "face %d vertex %d", k, j);
+    field_mesh_free(&m);
 }

@@ -234,6 +234,8 @@ static int write_include(const camera *c, const sub *subs, const field_render_pl
         if (field_mesh_append(&m, &s->mesh, s->at.dx, s->at.dy) < 0)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
+    if (!st && field_mesh_sort_faces_by_area(&m) < 0)
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     double world[12];
     world_matrix(c, world);
     if (!st && field_mesh_write_include(f->fp, &m, "Lens2pov_Field", world, placement) < 0)

@@ -1,6 +1,7 @@
 /* The distribution-3 camera mesh: storage and the include POV-Ray reads. */
 #include "field/fieldmesh.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -80,6 +81,40 @@ int field_mesh_append(field_mesh *m, const field_mesh *src, int dx, int dy)
     for (int k = 0; k < src->faces; k++)
         if (field_mesh_face(m, base + src->tri[k][0], base + src->tri[k][1], base + src->tri[k][2]) < 0)
             return -1;
+    return 0;
+}
+
+typedef struct face_key {
+    double area;
+    int index;
+} face_key;
+
+static int larger_first(const void *pa, const void *pb)
+{
+    const face_key *a = pa, *b = pb;
+    if (a->area != b->area)
+        return a->area < b->area ? 1 : -1;
+    return (a->index > b->index) - (a->index < b->index);
+}
+
+int field_mesh_sort_faces_by_area(field_mesh *m)
+{
+    face_key *key = malloc(sizeof *key * (size_t)m->faces + 1);
+    int (*tri)[3] = malloc(sizeof *tri * (size_t)m->faces + 1);
+    if (!key || !tri) {
+        free(key), free(tri);
+        return -1;
+    }
+    for (int k = 0; k < m->faces; k++) {
+        const double *a = m->pix[m->tri[k][0]], *b = m->pix[m->tri[k][1]], *c = m->pix[m->tri[k][2]];
+        key[k].area = fabs((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]));
+        key[k].index = k;
+    }
+    qsort(key, (size_t)m->faces, sizeof *key, larger_first);
+    for (int k = 0; k < m->faces; k++)
+        memcpy(tri[k], m->tri[key[k].index], sizeof tri[k]);
+    memcpy(m->tri, tri, sizeof *tri * (size_t)m->faces);
+    free(key), free(tri);
     return 0;
 }
 

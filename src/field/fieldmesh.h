@@ -35,6 +35,13 @@ int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double x, double y);
 int field_mesh_append(field_mesh *m, const field_mesh *src, int dx, int dy);
 int field_mesh_face(field_mesh *m, int a, int b, int c);
 
+/* Puts the faces in order of their pixel area, largest first (ties keep their order).
+   POV-Ray takes, for each pixel, the first face in order that holds it, scanning the faces of
+   one cell of a 10 x 10 grid over UV; largest first, most pixels find theirs early. Any order
+   gives the same rays: a pixel that several faces hold was checked against each of them.
+   Returns -1 when out of memory. */
+int field_mesh_sort_faces_by_area(field_mesh *m);
+
 /* Face k as POV-Ray parses it. */
 void field_mesh_povuv_face(const field_mesh *m, int k, povuv_face *f);
 

@@ -134,8 +134,10 @@ channel_map map_channels(const ImageSpec &spec)
     return m;
 }
 
-// Source pixels (file channels) to linear RGBA with associated alpha, as EXR stores it.
-void convert_to_rgba(const ImageSpec &spec, const std::vector<float> &src, float *dst)
+// Source pixels (nc file channels each) to linear RGBA with associated alpha, as EXR stores
+// it. dst may be src when nc is 4 (each pixel is read whole before it is written), as it is
+// for POV-Ray's EXR renders: one buffer, filled by the reader.
+void convert_to_rgba(const ImageSpec &spec, const float *src, float *dst)
 {
     const channel_map m = map_channels(spec);
     const encoding e = encoding_of(spec);
@@ -143,12 +145,14 @@ void convert_to_rgba(const ImageSpec &spec, const std::vector<float> &src, float
     for (size_t i = 0; i < n; i++) {
         const float *s = &src[i * nc];
         const float a = m.alpha >= 0 ? s[m.alpha] : 1.0f;
+        float rgba[4];
         for (int c = 0; c < 3; c++) {
             const float v = m.rgb[c] >= 0 ? to_linear(s[m.rgb[c]], e) : 0.0f;
             // Integer files were read unassociated so that decoding sees the true colour.
-            dst[4 * i + c] = e.kind == encoding::LINEAR ? v : v * a;
+            rgba[c] = e.kind == encoding::LINEAR ? v : v * a;
         }
-        dst[4 * i + 3] = a;
+        rgba[3] = a;
+        std::memcpy(&dst[4 * i], rgba, sizeof rgba);
     }
 }
 
@@ -166,12 +170,16 @@ int read_rgba(const char *path, int *width, int *height, float **pixels, l2p_err
     const ImageSpec spec = in->spec();
     if (spec.deep || spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
         return fail(err, L2P_FAILED, path, "not a flat image with pixels");
-    std::vector<float> src((size_t)spec.width * spec.height * spec.nchannels);
-    if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, src.data()))
-        return fail(err, L2P_FAILED, path, in->geterror());
-    float *out = (float *)std::malloc(sizeof(float) * 4 * (size_t)spec.width * spec.height);
+    const size_t n = (size_t)spec.width * spec.height;
+    std::vector<float> other(spec.nchannels == 4 ? 0 : n * spec.nchannels);
+    float *out = (float *)std::malloc(sizeof(float) * 4 * n);
     if (!out)
         return fail(err, L2P_FAILED, path, "out of memory");
+    float *src = spec.nchannels == 4 ? out : other.data();
+    if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, src)) {
+        std::free(out);
+        return fail(err, L2P_FAILED, path, in->geterror());
+    }
     convert_to_rgba(spec, src, out);
     *width = spec.width;
     *height = spec.height;
