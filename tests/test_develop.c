@@ -758,6 +758,31 @@ Test(image_io, grey_file_read_as_rgba)
     free(px);
 }
 
+/* A three-channel file (PPM) of distinct values: each pixel's channels land in its own RGBA,
+   in order (the reader converts in place, last pixel first). */
+Test(image_io, rgb_file_read_as_rgba_pixel_by_pixel)
+{
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "c.ppm");
+    FILE *fp = fopen(path, "wb");
+    fputs("P6\n3 2\n255\n", fp);
+    for (int i = 0; i < 18; i++)
+        fputc(10 * i + 3, fp);
+    fclose(fp);
+    int w, h;
+    float *px;
+    l2p_error err = {0, ""};
+    cr_assert_eq(image_read_rgba(path, &w, &h, &px, &err), L2P_OK, "%s", err.text);
+    cr_assert(w == 3 && h == 2);
+    for (int i = 0; i < 6; i++) {
+        for (int c = 0; c < 3; c++)
+            cr_assert_float_eq(px[4 * i + c], srgb_decode((10 * (3 * i + c) + 3) / 255.0), 1e-6,
+                               "pixel %d channel %d", i, c);
+        cr_assert_eq(px[4 * i + 3], 1.0f);
+    }
+    free(px);
+}
+
 /* ---- dispersion: bands in the map, colour in developing ---- */
 
 static void write_band_map(const char *path, const samplemap *m, const uint32_t *band)

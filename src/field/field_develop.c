@@ -1,7 +1,11 @@
 /* Developing a field render from its map and its renders' pictures (fieldmap.h). */
 #include "field/field_develop.h"
 
+#include <pthread.h>
+#include <signal.h>
+#include <stdbool.h>
 #include <stdlib.h>
+#include "base/cleanup.h"
 #include "image/develop.h"
 #include "image/image_io.h"
 #include "optics/spectrum.h"
@@ -30,22 +34,56 @@ static void add_subimage(const field_map *m, int k, const float *weights, const 
         }
 }
 
-/* Render r's picture and every sub-image in it. */
-static int add_render(const field_map *m, int r, const char *path, float *weights, double *sums,
+/* A render's picture, read on a thread of its own or the caller's. */
+typedef struct picture {
+    const char *path;
+    int width, height;
+    float *rgba;
+    int status;
+    l2p_error err;
+} picture;
+
+static void *read_picture(void *arg)
+{
+    picture *p = arg;
+    p->status = image_read_rgba(p->path, &p->width, &p->height, &p->rgba, &p->err);
+    return NULL;
+}
+
+/* Reads two pictures at once (decoding is most of developing), the second on a thread with
+   the termination signals blocked so that they reach the main thread's handler. */
+static void read_pair(picture p[2])
+{
+    pthread_t t;
+    sigset_t old;
+    bool threaded = false;
+    if (p[1].path) {
+        cleanup_block_signals(&old);
+        threaded = pthread_create(&t, NULL, read_picture, &p[1]) == 0;
+        pthread_sigmask(SIG_SETMASK, &old, NULL);
+    }
+    read_picture(&p[0]);
+    if (threaded)
+        pthread_join(t, NULL);
+    else if (p[1].path)
+        read_picture(&p[1]);
+}
+
+/* Render r's picture and every sub-image in it, in the order of the sub-images. */
+static int add_render(const field_map *m, int r, const picture *p, float *weights, double *sums,
                       l2p_error *err)
 {
-    int iw, ih;
-    float *rgba;
-    int st = image_read_rgba(path, &iw, &ih, &rgba, err);
-    if (st)
-        return st;
-    if (iw != m->width[r] + 1 || ih != m->height[r] + 1)
-        st = l2p_fail(err, L2P_BAD_INPUT, path, 0, "is %dx%d, not %dx%d: not render %d of this "
-                      "field map", iw, ih, m->width[r] + 1, m->height[r] + 1, r);
+    if (p->status) {
+        *err = p->err;
+        return p->status;
+    }
+    int st = L2P_OK;
+    if (p->width != m->width[r] + 1 || p->height != m->height[r] + 1)
+        st = l2p_fail(err, L2P_BAD_INPUT, p->path, 0, "is %dx%d, not %dx%d: not render %d of this "
+                      "field map", p->width, p->height, m->width[r] + 1, m->height[r] + 1, r);
     for (int k = 0; k < m->header.spp && !st; k++)
         if (m->at[k].render == r && !(st = field_map_weights(m, k, weights, err)))
-            add_subimage(m, k, weights, rgba, iw, sums);
-    free(rgba);
+            add_subimage(m, k, weights, p->rgba, p->width, sums);
     return st;
 }
 
@@ -61,8 +99,15 @@ int field_develop(const field_map *m, const char *const *renders, int count, con
     double *sums = calloc(develop_sums_per_pixel(h) * pixels, sizeof *sums);
     float *weights = malloc(sizeof *weights * pixels);
     int st = sums && weights ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int r = 0; r < count && !st; r++)
-        st = add_render(m, r, renders[r], weights, sums, err);
+    for (int r = 0; r < count && !st; r += 2) {
+        picture p[2] = {{.path = renders[r]}, {.path = r + 1 < count ? renders[r + 1] : NULL}};
+        read_pair(p);
+        for (int i = 0; i < 2 && p[i].path; i++) {
+            if (!st)
+                st = add_render(m, r + i, &p[i], weights, sums, err);
+            free(p[i].rgba);
+        }
+    }
     if (!st) {
         const samplemap map = {.header = *h};
         st = develop_write_picture(&map, sums, out, err);

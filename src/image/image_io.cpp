@@ -135,14 +135,15 @@ channel_map map_channels(const ImageSpec &spec)
 }
 
 // Source pixels (nc file channels each) to linear RGBA with associated alpha, as EXR stores
-// it. dst may be src when nc is 4 (each pixel is read whole before it is written), as it is
-// for POV-Ray's EXR renders: one buffer, filled by the reader.
+// it. dst may be src when nc is at most 4: the pixels go last first, each read whole before
+// it is written, and pixel i's RGBA covers only the channels of pixels i and above. So a
+// picture needs one buffer, filled by the reader.
 void convert_to_rgba(const ImageSpec &spec, const float *src, float *dst)
 {
     const channel_map m = map_channels(spec);
     const encoding e = encoding_of(spec);
     const size_t n = (size_t)spec.width * (size_t)spec.height, nc = (size_t)spec.nchannels;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = n; i-- > 0;) {
         const float *s = &src[i * nc];
         const float a = m.alpha >= 0 ? s[m.alpha] : 1.0f;
         float rgba[4];
@@ -171,11 +172,12 @@ int read_rgba(const char *path, int *width, int *height, float **pixels, l2p_err
     if (spec.deep || spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
         return fail(err, L2P_FAILED, path, "not a flat image with pixels");
     const size_t n = (size_t)spec.width * spec.height;
-    std::vector<float> other(spec.nchannels == 4 ? 0 : n * spec.nchannels);
+    const bool in_place = spec.nchannels <= 4;
+    std::vector<float> other(in_place ? 0 : n * spec.nchannels);
     float *out = (float *)std::malloc(sizeof(float) * 4 * n);
     if (!out)
         return fail(err, L2P_FAILED, path, "out of memory");
-    float *src = spec.nchannels == 4 ? out : other.data();
+    float *src = in_place ? out : other.data();
     if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, src)) {
         std::free(out);
         return fail(err, L2P_FAILED, path, in->geterror());
