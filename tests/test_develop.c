@@ -733,22 +733,29 @@ Test(image_io, read_errors)
     cr_assert_null(px);
 }
 
+/* Reads an 8-bit netpbm file of w x h pixels (P5: grey, P6: RGB) written from bytes. */
+static float *read_netpbm(const char *name, const char *magic, int w, int h,
+                          const unsigned char *bytes, size_t n)
+{
+    const char *path = tmp_path(test_tmpdir(), name);
+    FILE *fp = fopen(path, "wb");
+    cr_assert_not_null(fp);
+    fprintf(fp, "%s\n%d %d\n255\n", magic, w, h);
+    fwrite(bytes, 1, n, fp);
+    fclose(fp);
+    int rw, rh;
+    float *px;
+    l2p_error err = {0, ""};
+    cr_assert_eq(image_read_rgba(path, &rw, &rh, &px, &err), L2P_OK, "%s", err.text);
+    cr_assert(rw == w && rh == h);
+    return px;
+}
+
 /* A one-channel 8-bit file (PGM) is grey with alpha 1, sRGB-decoded. */
 Test(image_io, grey_file_read_as_rgba)
 {
-    const char *dir = test_tmpdir();
-    const char *path = tmp_path(dir, "g.pgm");
-    FILE *fp = fopen(path, "wb");
-    fputs("P5\n3 1\n255\n", fp);
-    fputc(0, fp);
-    fputc(188, fp);
-    fputc(255, fp);
-    fclose(fp);
-    int w, h;
-    float *px;
-    l2p_error err = {0, ""};
-    cr_assert_eq(image_read_rgba(path, &w, &h, &px, &err), L2P_OK, "%s", err.text);
-    cr_assert(w == 3 && h == 1);
+    const unsigned char grey[3] = {0, 188, 255};
+    float *px = read_netpbm("g.pgm", "P5", 3, 1, grey, sizeof grey);
     const double want[3] = {0.0, srgb_decode(188 / 255.0), 1.0};
     for (int i = 0; i < 3; i++) {
         for (int c = 0; c < 3; c++)
@@ -762,18 +769,10 @@ Test(image_io, grey_file_read_as_rgba)
    in order (the reader converts in place, last pixel first). */
 Test(image_io, rgb_file_read_as_rgba_pixel_by_pixel)
 {
-    const char *dir = test_tmpdir();
-    const char *path = tmp_path(dir, "c.ppm");
-    FILE *fp = fopen(path, "wb");
-    fputs("P6\n3 2\n255\n", fp);
+    unsigned char rgb[18];
     for (int i = 0; i < 18; i++)
-        fputc(10 * i + 3, fp);
-    fclose(fp);
-    int w, h;
-    float *px;
-    l2p_error err = {0, ""};
-    cr_assert_eq(image_read_rgba(path, &w, &h, &px, &err), L2P_OK, "%s", err.text);
-    cr_assert(w == 3 && h == 2);
+        rgb[i] = (unsigned char)(10 * i + 3);
+    float *px = read_netpbm("c.ppm", "P6", 3, 2, rgb, sizeof rgb);
     for (int i = 0; i < 6; i++) {
         for (int c = 0; c < 3; c++)
             cr_assert_float_eq(px[4 * i + c], srgb_decode((10 * (3 * i + c) + 3) / 255.0), 1e-6,

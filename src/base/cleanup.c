@@ -96,6 +96,15 @@ void cleanup_block_signals(sigset_t *old)
     pthread_sigmask(SIG_BLOCK, &block, old);
 }
 
+int cleanup_start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
+{
+    sigset_t old;
+    cleanup_block_signals(&old);
+    const int r = pthread_create(t, NULL, fn, arg);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return r;
+}
+
 void cleanup_install(void)
 {
     struct sigaction sa;

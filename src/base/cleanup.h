@@ -5,6 +5,7 @@
 #ifndef LENS2POV_CLEANUP_H
 #define LENS2POV_CLEANUP_H
 
+#include <pthread.h>
 #include <signal.h>
 #include <sys/types.h>
 
@@ -27,6 +28,10 @@ void cleanup_untrack_child(pid_t pid);
    *old: for a fork that must register its child first, and for threads that must leave the
    handler to the main thread. */
 void cleanup_block_signals(sigset_t *old);
+
+/* pthread_create with those signals blocked in the new thread, so that they reach the main
+   thread, whose handler stops the POV-Ray processes it tracks. */
+int cleanup_start_thread(pthread_t *t, void *(*fn)(void *), void *arg);
 
 #ifdef __cplusplus
 }

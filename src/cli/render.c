@@ -2,7 +2,6 @@
 
 #include <errno.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -85,17 +84,6 @@ static long long chunk_faces_for(const camera *cam, const cli *c, int jobs, int 
     const long long per_chunk = (faces + count - 1) / count;
     *chunks = (int)count;
     return per_chunk > 0 ? per_chunk : 1;
-}
-
-/* Starts a thread with SIGINT, SIGTERM and SIGHUP blocked, so that they reach the main thread,
-   whose handler stops the POV-Ray processes it tracks. */
-static int start_thread(pthread_t *t, void *(*fn)(void *), void *arg)
-{
-    sigset_t old;
-    cleanup_block_signals(&old);
-    const int r = pthread_create(t, NULL, fn, arg);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
-    return r;
 }
 
 /* The image library (about 0.3 s of dlopen) loads on the main thread once the first POV-Ray
@@ -284,7 +272,7 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     pthread_mutex_init(&w.lock, NULL);
     pthread_t thread;
-    int st = start_thread(&thread, write_table, &w) == 0
+    int st = cleanup_start_thread(&thread, write_table, &w) == 0
                  ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start a thread");
     if (!st) {
         /* The image library must be there before POV-Ray runs (a file check); it loads once

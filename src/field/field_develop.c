@@ -1,8 +1,6 @@
 /* Developing a field render from its map and its renders' pictures (fieldmap.h). */
 #include "field/field_develop.h"
 
-#include <pthread.h>
-#include <signal.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include "base/cleanup.h"
@@ -50,18 +48,12 @@ static void *read_picture(void *arg)
     return NULL;
 }
 
-/* Reads two pictures at once (decoding is most of developing), the second on a thread with
-   the termination signals blocked so that they reach the main thread's handler. */
+/* Reads two pictures at once (decoding is most of developing), the second on a thread of its
+   own. */
 static void read_pair(picture p[2])
 {
     pthread_t t;
-    sigset_t old;
-    bool threaded = false;
-    if (p[1].path) {
-        cleanup_block_signals(&old);
-        threaded = pthread_create(&t, NULL, read_picture, &p[1]) == 0;
-        pthread_sigmask(SIG_SETMASK, &old, NULL);
-    }
+    const bool threaded = p[1].path && cleanup_start_thread(&t, read_picture, &p[1]) == 0;
     read_picture(&p[0]);
     if (threaded)
         pthread_join(t, NULL);
