@@ -131,21 +131,30 @@ static long long face_budget(long long faces, int spp, int w, int h)
     return (long long)fmax(1.0, fmin(b, FIELD_FACES_PER_RENDER));
 }
 
+/* How far a picture of w x h is from square: POV-Ray's grid cells are a tenth of each side,
+   and a face is a candidate in every cell its UV box touches, so square cells are straddled by
+   fewer faces. */
+static double oblong(int w, int h)
+{
+    return fabs(log((w + 1.0) / (h + 1.0)));
+}
+
 /* The grid of n sub-images (its columns) with the smallest picture no larger than the n lone
-   sub-images' would be (its sides 2^a - 1: every UV a short binary fraction); 0 when none is.
-   A power of two always has one, and POV-Ray renders only the grid (write_ini): the rest of
-   the picture costs memory, not time. */
+   sub-images' would be (its sides 2^a - 1: every UV a short binary fraction), of those the
+   squarest; 0 when none is. A power of two always has one, and POV-Ray renders only the grid
+   (write_ini): the rest of the picture costs memory, not time. */
 static int grid_of(int n, int w, int h)
 {
     const double lone = (field_render_size(w) + 1.0) * (field_render_size(h) + 1.0);
-    double best = INFINITY;
+    double best = INFINITY, best_oblong = INFINITY;
     int best_nx = 0;
     for (int nx = 1; nx <= n; nx++) {
         int rw, rh;
         grid_size(n, nx, w, h, &rw, &rh);
         const double area = (rw + 1.0) * (rh + 1.0);
-        if (area <= n * lone && area < best)
-            best = area, best_nx = nx;
+        if (area > n * lone || area > best || (area == best && oblong(rw, rh) >= best_oblong))
+            continue;
+        best = area, best_oblong = oblong(rw, rh), best_nx = nx;
     }
     return best_nx;
 }
