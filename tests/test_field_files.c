@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "field/field_develop.h"
 #include "field/fieldmap.h"
 #include "image/image_io.h"
 #include "support.h"
@@ -85,6 +86,36 @@ Test(field_files, trace_povray_develop_is_render)
         cr_expect(sum > 100, "the picture is not black (%g)", sum);
         free(a), free(b);
     }
+}
+
+/* Developing a render at a time, the pictures given last first, makes the picture develop
+   makes of them all at once, bit for bit (the renders are added in their order whatever order
+   they come in); a render given twice is refused. */
+Test(field_files, developing_a_render_at_a_time_is_developing_all)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *all = tmp_path(dir, "all.exr"), *each = tmp_path(dir, "each.exr");
+    const int renders = by_hand(dir, LENS_DIR "dgauss.50mm.dat", all);
+    field_map m;
+    l2p_error err;
+    cr_assert_eq(field_map_read(tmp_path(dir, "ft.map"), &m, &err), 0, "%s", err.text);
+    cr_assert_eq(m.renders, renders);
+    field_developer d;
+    cr_assert_eq(field_develop_start(&d, &m, &err), 0, "%s", err.text);
+    for (int r = renders - 1; r >= 0; r--) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s.f%03d.exr", tmp_path(dir, "ft"), r);
+        cr_assert_eq(field_develop_add(&d, r, path, &err), 0, "%s", err.text);
+        cr_expect_eq(d.next, r ? 0 : renders, "render %d given: %d added", r, d.next);
+        cr_expect_eq(field_develop_add(&d, r, path, &err), L2P_FAILED, "render %d twice", r);
+    }
+    cr_assert_eq(field_develop_finish(&d, each, &err), 0, "%s", err.text);
+    field_develop_free(&d);
+    field_map_free(&m);
+    float *a = read_picture(all), *b = read_picture(each);
+    cr_expect(memcmp(a, b, sizeof *a * 4 * 40 * 30) == 0, "the pictures differ");
+    free(a), free(b);
 }
 
 /* develop refuses renders that do not belong to the map: too few, and one of another size,

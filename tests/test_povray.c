@@ -62,8 +62,8 @@ static void write_ini(const char *path, const char *exr)
 
 typedef struct fixture {
     char *dir;
-    povray_chunk chunk[2];
-    char *paths[6];
+    povray_chunk chunk[3];
+    char *paths[9];
 } fixture;
 
 /* Chunk i: dir/rays.c00i.{inc,ini,exr}, rays along dz[i]. */
@@ -85,14 +85,14 @@ static void make_chunks(fixture *fx, const char *dir, int count, const int *dz)
 
 static void free_fixture(fixture *fx)
 {
-    for (int i = 0; i < 6; i++)
+    for (int i = 0; i < 9; i++)
         free(fx->paths[i]);
     free(fx->dir);
 }
 
 static povray_options options(const char *scene, const char *work_dir, int jobs)
 {
-    return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL, NULL, 0, 0, 0, NULL, NULL};
+    return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL, NULL};
 }
 
 /* The one-chunk table of make_chunks rendered from dir with scene, one job. */
@@ -471,6 +471,71 @@ Test(povray, a_sequence_renders_its_chunks_as_the_frames_of_one_process)
     free_fixture(&fx);
     free(scene);
     free(script);
+    remove_tree(dir);
+    free(dir);
+}
+
+/* What picture_done saw: the chunks in the order reported, and how many of them came while
+   their POV-Ray process still ran (the script notes its end in dir/ended). */
+typedef struct reports {
+    const fixture *fx;
+    char *ended;
+    int chunk[8], count, while_running, fail_at;
+} reports;
+
+static int note_picture(void *ctx, int k, l2p_error *err)
+{
+    reports *r = ctx;
+    if (r->count < 8)
+        r->chunk[r->count] = k;
+    r->count++;
+    if (access(r->ended, F_OK) != 0)
+        r->while_running++;
+    /* complete where it was reported: every pixel its chunk's colour */
+    expect_uniform(r->fx->chunk[k].output_exr, k == 1 ? 0 : 1, k == 1 ? 1 : 0, 0);
+    return k == r->fail_at ? l2p_fail(err, L2P_FAILED, NULL, 0, "stopped at chunk %d", k) : L2P_OK;
+}
+
+/* A sequence's frames are reported one by one in their order, each complete in its chunk's
+   output_exr, and (POV-Ray closes a frame's picture before it parses the next one, and takes
+   about a quarter of a second to exit) most of them before their process has ended. A
+   nonzero return stops the run with its error. */
+Test(povray, a_sequence_reports_each_frame_when_povray_has_closed_it)
+{
+    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                    "plane { -z, 0 pigment { rgb <1,0,0> } finish { ambient 1 diffuse 0 } }\n"
+                    "plane { z, -10 pigment { rgb <0,1,0> } finish { ambient 1 diffuse 0 } }\n");
+    char *script = fmt("%s/%s", dir, "endpov"), *ended = fmt("%s/%s", dir, "ended");
+    char *text = fmt("#!/bin/sh\npovray \"$@\"; st=$?\necho end > '%s'\nexit $st\n%s", ended, "");
+    write_text(script, text);
+    chmod(script, 0755);
+    fixture fx;
+    make_chunks(&fx, dir, 3, (const int[]){1, -1, 1});
+    povray_options o = options(scene, dir, 1);
+    o.povray = script;
+    reports seen = {.fx = &fx, .ended = ended, .fail_at = -1};
+    o.picture_done = note_picture;
+    o.picture_ctx = &seen;
+    l2p_error err = {0};
+    cr_assert_eq(povray_render_sequences(fx.chunk, (const int[]){3}, 1, &o, &err), L2P_OK, "%s",
+                 err.text);
+    cr_assert_eq(seen.count, 3);
+    for (int k = 0; k < 3; k++)
+        cr_expect_eq(seen.chunk[k], k, "report %d is chunk %d", k, seen.chunk[k]);
+    cr_expect_geq(seen.while_running, 1, "every frame was reported after POV-Ray had ended");
+    cr_expect_eq(count_entries(dir, "povray.s000.f", NULL, 0), 0, "frame files left");
+
+    /* an error from picture_done stops the run with it */
+    for (int k = 0; k < 3; k++)
+        unlink(fx.chunk[k].output_exr);
+    unlink(ended);
+    seen = (reports){.fx = &fx, .ended = ended, .fail_at = 0};
+    cr_assert_eq(povray_render_sequences(fx.chunk, (const int[]){3}, 1, &o, &err), L2P_FAILED);
+    cr_expect_str_eq(err.text, "stopped at chunk 0");
+    cr_expect_eq(seen.count, 1);
+    free_fixture(&fx);
+    free(scene), free(script), free(ended), free(text);
     remove_tree(dir);
     free(dir);
 }

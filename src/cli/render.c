@@ -283,7 +283,7 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
                                    !c->quiet, NULL, chunks_ready, &w, c->povray_args,
                                    c->povray_arg_count, c->cam.width, c->cam.height,
-                                   load_image_library, NULL};
+                                   load_image_library, NULL, NULL, NULL};
         if (!st)
             st = povray_render_chunks(pc, count * tf->count, &po, err);
         if (st)

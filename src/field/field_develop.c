@@ -3,6 +3,7 @@
 
 #include <stdbool.h>
 #include <stdlib.h>
+#include <string.h>
 #include "base/cleanup.h"
 #include "image/develop.h"
 #include "image/image_io.h"
@@ -79,6 +80,65 @@ static int add_render(const field_map *m, int r, const picture *p, float *weight
     return st;
 }
 
+int field_develop_start(field_developer *d, const field_map *m, l2p_error *err)
+{
+    memset(d, 0, sizeof *d);
+    d->map = m;
+    const samplemap_header *h = &m->header;
+    const size_t pixels = (size_t)(h->crop_x1 - h->crop_x0) * (size_t)(h->crop_y1 - h->crop_y0);
+    d->sums = calloc(develop_sums_per_pixel(h) * pixels, sizeof *d->sums);
+    d->weights = malloc(sizeof *d->weights * pixels);
+    d->picture = calloc((size_t)m->renders + 1, sizeof *d->picture);
+    if (!d->sums || !d->weights || !d->picture) {
+        field_develop_free(d);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
+    return L2P_OK;
+}
+
+void field_develop_free(field_developer *d)
+{
+    for (int r = 0; d->picture && r < d->map->renders; r++)
+        free(d->picture[r]);
+    free(d->picture), free(d->sums), free(d->weights);
+    memset(d, 0, sizeof *d);
+}
+
+/* Adds the renders from d->next on whose pictures are known, two at a time. */
+static int add_known(field_developer *d, l2p_error *err)
+{
+    int st = L2P_OK;
+    while (!st && d->next < d->map->renders && d->picture[d->next]) {
+        const int r = d->next, two = r + 1 < d->map->renders && d->picture[r + 1];
+        picture p[2] = {{.path = d->picture[r]}, {.path = two ? d->picture[r + 1] : NULL}};
+        read_pair(p);
+        for (int i = 0; i < 2 && p[i].path; i++) {
+            if (!st)
+                st = add_render(d->map, r + i, &p[i], d->weights, d->sums, err);
+            free(p[i].rgba);
+        }
+        d->next += 1 + two;
+    }
+    return st;
+}
+
+int field_develop_add(field_developer *d, int r, const char *path, l2p_error *err)
+{
+    if (r < 0 || r >= d->map->renders || r < d->next || d->picture[r])
+        return l2p_fail(err, L2P_FAILED, path, 0, "render %d given twice or out of range", r);
+    if (!(d->picture[r] = strdup(path)))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    return add_known(d, err);
+}
+
+int field_develop_finish(field_developer *d, const char *out, l2p_error *err)
+{
+    if (d->next < d->map->renders)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "render %d was not developed", d->next);
+    const samplemap map = {.header = d->map->header};
+    return develop_write_picture(&map, d->sums, out, err);
+}
+
 int field_develop(const field_map *m, const char *const *renders, int count, const char *out,
                   l2p_error *err)
 {
@@ -86,24 +146,17 @@ int field_develop(const field_map *m, const char *const *renders, int count, con
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "the field map has %d render%s but %d %s "
                         "given", m->renders, m->renders == 1 ? "" : "s", count,
                         count == 1 ? "was" : "were");
-    const samplemap_header *h = &m->header;
-    const size_t pixels = (size_t)(h->crop_x1 - h->crop_x0) * (size_t)(h->crop_y1 - h->crop_y0);
-    double *sums = calloc(develop_sums_per_pixel(h) * pixels, sizeof *sums);
-    float *weights = malloc(sizeof *weights * pixels);
-    int st = sums && weights ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int r = 0; r < count && !st; r += 2) {
-        picture p[2] = {{.path = renders[r]}, {.path = r + 1 < count ? renders[r + 1] : NULL}};
-        read_pair(p);
-        for (int i = 0; i < 2 && p[i].path; i++) {
-            if (!st)
-                st = add_render(m, r + i, &p[i], weights, sums, err);
-            free(p[i].rgba);
-        }
-    }
-    if (!st) {
-        const samplemap map = {.header = *h};
-        st = develop_write_picture(&map, sums, out, err);
-    }
-    free(sums), free(weights);
+    field_developer d;
+    int st = field_develop_start(&d, m, err);
+    if (st)
+        return st;
+    for (int r = 0; r < count && !st; r++)
+        if (!(d.picture[r] = strdup(renders[r])))
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    if (!st)
+        st = add_known(&d, err);
+    if (!st)
+        st = field_develop_finish(&d, out, err);
+    field_develop_free(&d);
     return st;
 }

@@ -11,4 +11,25 @@
 int field_develop(const field_map *m, const char *const *renders, int count, const char *out,
                   l2p_error *err);
 
+/* The same, a render at a time as its picture comes: the renders are added in their order
+   (the sums then do not depend on the order pictures come in), each as soon as it and those
+   before it are known. */
+typedef struct field_developer {
+    const field_map *map;
+    double *sums;
+    float *weights;
+    char **picture;     /* render r's picture once given */
+    int next;           /* the first render not yet added */
+} field_developer;
+
+int field_develop_start(field_developer *d, const field_map *m, l2p_error *err);
+
+/* Render r's picture is complete at path. L2P_FAILED for a render given twice; errors of
+   field_develop. */
+int field_develop_add(field_developer *d, int r, const char *path, l2p_error *err);
+
+/* Writes the picture once every render has been added. */
+int field_develop_finish(field_developer *d, const char *out, l2p_error *err);
+void field_develop_free(field_developer *d);
+
 #endif

@@ -5,6 +5,7 @@
    sampling runs its chunks. */
 #include "field/field_render.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,8 +54,26 @@ static int assign_jobs(const field_render_plan *plans, int renders, int jobs, in
     return n;
 }
 
-/* Each POV-Ray job renders its share of the renders as one animation (assign_jobs). */
-static int render_by_jobs(const field_files *f, int jobs, const povray_options *po, l2p_error *err)
+/* Develops each render as soon as POV-Ray has closed its picture (povray_options'
+   picture_done), so that developing overlaps the frames still rendering and POV-Ray's exit. */
+typedef struct developing {
+    field_developer dev;
+    const field_files *f;
+    const int *order;   /* the run's chunk k is render order[k] */
+} developing;
+
+static int picture_done(void *ctx, int k, l2p_error *err)
+{
+    developing *d = ctx;
+    const int r = d->order[k];
+    const int st = image_io_ready(err);
+    return st ? st : field_develop_add(&d->dev, r, d->f->chunk[r].output_exr, err);
+}
+
+/* Each POV-Ray job renders its share of the renders as one animation (assign_jobs); the
+   picture goes to out. */
+static int render_by_jobs(const field_files *f, int jobs, const povray_options *po,
+                          const char *out, l2p_error *err)
 {
     povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
     int *order = calloc((size_t)f->renders + 1, sizeof *order);
@@ -64,8 +83,21 @@ static int render_by_jobs(const field_files *f, int jobs, const povray_options *
     int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int k = 0; k < f->renders && !st; k++)
         by_job[k] = f->chunk[order[k]];
+    field_map m;
+    developing d = {.f = f, .order = order};
+    const bool have_map = !st && !(st = field_map_read(f->map_path, &m, err));
+    const bool have_dev = have_map && !(st = field_develop_start(&d.dev, &m, err));
+    povray_options with_pictures = *po;
+    with_pictures.picture_done = picture_done;
+    with_pictures.picture_ctx = &d;
     if (!st)
-        st = povray_render_sequences(by_job, frames, n, po, err);
+        st = povray_render_sequences(by_job, frames, n, &with_pictures, err);
+    if (!st)
+        st = field_develop_finish(&d.dev, out, err);
+    if (have_dev)
+        field_develop_free(&d.dev);
+    if (have_map)
+        field_map_free(&m);
     free(by_job), free(order), free(frames);
     return st;
 }
@@ -147,13 +179,14 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     povray_chunk *pc = st || one_run_a_job ? NULL : frame_chunks(&f, o);
     if (!st && !one_run_a_job && !pc)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    if (!st)
-        st = one_run_a_job ? render_by_jobs(&f, o->jobs, &po, err)
-                           : povray_render_chunks(pc, f.renders * o->frame_count, &po, err);
-    if (!st)
+    if (!st && one_run_a_job)
+        st = render_by_jobs(&f, o->jobs, &po, o->frames[0].output, err);
+    else if (!st)
+        st = povray_render_chunks(pc, f.renders * o->frame_count, &po, err);
+    if (!st && !one_run_a_job)
         st = image_io_ready(err);
-    if (!st)
-        st = develop_frames(&f, one_run_a_job ? f.chunk : pc, o, err);
+    if (!st && !one_run_a_job)
+        st = develop_frames(&f, pc, o, err);
     free_frame_chunks(pc, f.renders * o->frame_count);
     field_files_free(&f);
     return st;

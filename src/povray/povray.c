@@ -171,25 +171,26 @@ static int explain_failure(const run *r, job *j, int status, l2p_error *err)
                     WIFEXITED(status) ? WEXITSTATUS(status) : -1, j->log_path);
 }
 
-/* A finished job: success needs exit status 0 and the EXR on disk; a sequence's frames are
-   moved to their chunks' output_exr. */
-static int check_finished(const run *r, job *j, int status, l2p_error *err)
+/* A finished job: success needs exit status 0 and the EXR on disk; a sequence's frames not
+   yet reported are moved to their chunks' output_exr, and every picture is reported. */
+static int check_finished(run *r, job *j, int status, l2p_error *err)
 {
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
         return explain_failure(r, j, status, err);
     int st = L2P_OK;
     for (int i = 0; i < task_chunks(r, j->task) && !st; i++) {
-        const char *out = r->chunks[task_first(r, j->task) + i].output_exr;
+        const int k = task_first(r, j->task) + i;
+        if (r->reported[k])
+            continue;
         char *frame = r->frames ? povray_frame_output(r, j->task, i + 1) : NULL;
-        const char *written = frame ? frame : out;
+        const char *written = frame ? frame : r->chunks[k].output_exr;
         if (r->frames && !frame)
             st = povray_out_of_memory(err);
         else if (access(written, R_OK) != 0)
             st = l2p_fail(err, L2P_FAILED, written, 0,
                           "POV-Ray finished without writing it (log: %s)", j->log_path);
-        else if (frame && rename(frame, out) != 0)
-            st = l2p_fail(err, L2P_FAILED, out, 0, "cannot move %s here: %s", frame,
-                          strerror(errno));
+        else
+            st = povray_picture_finished(r, k, written, err);
         free(frame);
     }
     return st;
@@ -292,6 +293,7 @@ static int schedule(run *r, l2p_error *err)
 {
     int next = 0, finished = 0, chunks_done = 0, ready = 0, st = L2P_OK;
     bool told = !r->opts->started;
+    povray_watch_frames(r);
     for (int tick = 0; !st && finished < r->tasks; tick++) {
         st = poll_chunks(r, &ready, err);
         for (int i = 0; i < r->job_slots && next < r->tasks && !st &&
@@ -302,13 +304,15 @@ static int schedule(run *r, l2p_error *err)
             told = true;
             r->opts->started(r->opts->started_ctx);
         }
+        if (!st)
+            st = povray_collect_frames(r, err);
         const int ended = st ? 0 : reap_jobs(r, &chunks_done, &st, err);
         finished += ended;
         if (ended || st)
             continue;  /* start the next chunks at once */
         if (tick % DRAW_EVERY_TICKS == 0)
             draw_progress(r, chunks_done);
-        sleep_ms(TICK_MS);
+        povray_wait_ms(r, TICK_MS);
     }
     if (!st)
         draw_progress(r, chunks_done);

@@ -33,6 +33,9 @@ void povray_run_free(run *r)
         free(r->jobs[i].log_path);
     free(r->jobs);
     free(r->first);
+    free(r->reported);
+    if (r->notify_fd >= 0)
+        close(r->notify_fd);
 }
 
 /* WORK/povray.cNNN.EXT, chunk NNN's wrapper and log; WORK/povray.sNNN.EXT, sequence NNN's. */
@@ -138,6 +141,7 @@ int povray_run_prepare(run *r, const povray_chunk *chunks, int count, const int 
                        int tasks, const povray_options *opts, l2p_error *err)
 {
     memset(r, 0, sizeof *r);
+    r->notify_fd = -1;
     r->chunks = chunks;
     r->count = count;
     r->frames = frames;
@@ -150,7 +154,8 @@ int povray_run_prepare(run *r, const povray_chunk *chunks, int count, const int 
         for (int t = 0; t < tasks; t++)
             r->first[t] = t ? r->first[t - 1] + frames[t - 1] : 0;
     r->jobs = calloc((size_t)r->job_slots, sizeof *r->jobs);
-    if (frames && !r->first)
+    r->reported = calloc((size_t)count, sizeof *r->reported);
+    if ((frames && !r->first) || !r->reported)
         return povray_out_of_memory(err);
     r->work_dir = absolute_path(opts->work_dir);
     r->chunk_prefix = r->work_dir ? str_printf("%s/povray", r->work_dir) : NULL;

@@ -38,6 +38,8 @@ typedef struct run {
     job *jobs;
     int job_slots;
     bool writing;              /* chunks still being written: their writer draws its own bar */
+    bool *reported;            /* a chunk's picture is at its output_exr and was reported */
+    int notify_fd;             /* inotify on work_dir for a sequence's frames; -1: none */
     progress bar;
 } run;
 
@@ -82,5 +84,21 @@ char *povray_task_file_name(const run *r, int t, const char *ext);
 char *povray_frame_output(const run *r, int t, int f);
 
 int povray_out_of_memory(l2p_error *err);
+
+/* Finished pictures (povray_pictures.c). Chunk k's picture is complete at written (its
+   output_exr, or the frame POV-Ray wrote): moved to output_exr and reported to
+   opts->picture_done, once. */
+int povray_picture_finished(run *r, int k, const char *written, l2p_error *err);
+
+/* Starts watching the work folder for a sequence's closed frames when opts->picture_done
+   wants them (nothing when inotify is not there: frames are then found as their process
+   ends). */
+void povray_watch_frames(run *r);
+
+/* Finishes the frames of running jobs that POV-Ray has closed since the last call. */
+int povray_collect_frames(run *r, l2p_error *err);
+
+/* Waits ms milliseconds, less when a watched frame is closed. */
+void povray_wait_ms(const run *r, int ms);
 
 #endif
