@@ -31,6 +31,7 @@ int field_render_size(int n)
 typedef struct builder {
     const camera *c;
     const field_tolerance *tol;
+    double sin_angle;          /* sin(tol->angle_rad) */
     int w, h;
     ray *rays;                 /* mesh space: camera space less the front vertex */
     unsigned char *passed, *covered;
@@ -139,13 +140,16 @@ static void pixel_face(const builder *b, const int px[3][2], povuv_face *f)
     povuv_face_init(f, pos, nrm, uv);
 }
 
-/* The error of the model's ray against the exact one, in units of the tolerance. */
+/* The error of the model's ray against the exact one, in units of the tolerance. For unit
+   directions |a x b| is the sine of the angle between them: below a right angle, comparing
+   sines is comparing angles, without an atan2 at every pixel. */
 static double ray_error(const builder *b, const ray *exact, vec3 o, vec3 d)
 {
-    double angle = atan2(v3_length(v3_cross(exact->d, d)), v3_dot(exact->d, d));
+    const double angle = v3_dot(exact->d, d) > 0
+                             ? v3_length(v3_cross(exact->d, d)) / b->sin_angle : INFINITY;
     vec3 e = v3_sub(o, exact->o);
     vec3 across = v3_sub(e, v3_scale(exact->d, v3_dot(e, exact->d)));
-    return fmax(angle / b->tol->angle_rad, v3_length(across) / b->tol->origin_mm);
+    return fmax(angle, v3_length(across) / b->tol->origin_mm);
 }
 
 /* Whether pixel (x, y) is fine with face f: outside it, or inside with a ray within the
@@ -340,7 +344,8 @@ static void build_grid(builder *b, int base)
 int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
                          field_mesh *out, float *weights, field_stats *st, l2p_error *err)
 {
-    builder b = {.c = c, .tol = t, .w = c->crop_x1 - c->crop_x0, .h = c->crop_y1 - c->crop_y0,
+    builder b = {.c = c, .tol = t, .sin_angle = sin(t->angle_rad),
+                 .w = c->crop_x1 - c->crop_x0, .h = c->crop_y1 - c->crop_y0,
                  .m = out, .st = st, .weights = weights};
     const size_t n = (size_t)b.w * b.h;
     memset(st, 0, sizeof *st);
