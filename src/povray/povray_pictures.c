@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/inotify.h>
-#include <time.h>
 #include <unistd.h>
 #include "povray/povray_run.h"
 
@@ -80,11 +79,6 @@ int povray_collect_frames(run *r, l2p_error *err)
 
 void povray_wait_ms(const run *r, int ms)
 {
-    if (r->notify_fd >= 0) {
-        struct pollfd p = {.fd = r->notify_fd, .events = POLLIN};
-        poll(&p, 1, ms);
-        return;
-    }
-    const struct timespec t = {ms / 1000, (long)(ms % 1000) * 1000000L};
-    nanosleep(&t, NULL);
+    struct pollfd p = {.fd = r->notify_fd, .events = POLLIN};
+    poll(&p, r->notify_fd >= 0, ms);   /* no descriptor: a plain wait */
 }
