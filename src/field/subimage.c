@@ -1,8 +1,9 @@
 /* The adaptive mesh of one sub-image. Every pixel's exact ray is traced (the guarantee is
-   checked at every pixel, so nothing less would do); a quadtree of cells whose corners are
-   pixels is refined until, at every pixel a cell's two faces contain, the model of POV-Ray's
-   ray (povuv.c) is within the tolerance of the exact one, or until it reaches single pixels
-   where the lens blocks some corners. Pixels no face took get a tiny face of their own. */
+   checked at every pixel, so nothing less would do); cells whose corners are pixels are
+   refined until, at every pixel a cell's two faces contain, the model of POV-Ray's ray
+   (povuv.c) is within the tolerance of the exact one (a passing cell halved across its longer
+   side, a cell the lens partly blocks split in four), or until they reach single pixels where
+   the lens blocks some corners. Pixels no face took get a tiny face of their own. */
 #include "field/subimage.h"
 
 #include <stdlib.h>
@@ -205,7 +206,7 @@ static void emit(builder *b, const int px[3][2], double worst)
     b->st->worst_pixels = fmax(b->st->worst_pixels, worst * b->tol->pixels);
 }
 
-/* ---------------------------------------------------------------- the quadtree */
+/* ---------------------------------------------------------------- the cells */
 
 /* A cell's two faces split along the diagonal from its top-right to its bottom-left corner. */
 static void cell_faces(int x0, int y0, int x1, int y1, int t[2][3][2])
@@ -271,6 +272,16 @@ static void build_cell(builder *b, int x0, int y0, int x1, int y1)
     bool sx = x1 - x0 >= 2, sy = y1 - y0 >= 2;
     if (!sx && !sy) {
         finest(b, x0, y0, x1, y1);
+        return;
+    }
+    /* A passing cell is halved across its longer side only: where the error grows faster one
+       way (distortion, mostly radial), the halves are often within the tolerance already, two
+       faces each where a split in four makes eight (docs/fields.md). */
+    if (pass == area) {
+        const bool along_x = sx && (x1 - x0 >= y1 - y0 || !sy);
+        const int mx = along_x ? (x0 + x1) / 2 : x1, my = along_x ? y1 : (y0 + y1) / 2;
+        build_cell(b, x0, y0, mx, my);
+        build_cell(b, along_x ? mx : x0, along_x ? y0 : my, x1, y1);
         return;
     }
     int mx = sx ? (x0 + x1) / 2 : x1, my = sy ? (y0 + y1) / 2 : y1;
