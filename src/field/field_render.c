@@ -151,10 +151,10 @@ static int grid_of(int n, int w, int h)
     for (int nx = 1; nx <= n; nx++) {
         int rw, rh;
         grid_size(n, nx, w, h, &rw, &rh);
-        const double area = (rw + 1.0) * (rh + 1.0);
-        if (area > n * lone || area > best || (area == best && oblong(rw, rh) >= best_oblong))
+        const double area = (rw + 1.0) * (rh + 1.0), shape = oblong(rw, rh);
+        if (area > n * lone || area > best || (area == best && shape >= best_oblong))
             continue;
-        best = area, best_oblong = oblong(rw, rh), best_nx = nx;
+        best = area, best_oblong = shape, best_nx = nx;
     }
     return best_nx;
 }

@@ -146,11 +146,11 @@ static void pixel_face(const builder *b, const int px[3][2], povuv_face *f)
    sines is comparing angles, without an atan2 at every pixel. */
 static double ray_error(const builder *b, const ray *exact, vec3 o, vec3 d)
 {
-    const double angle = v3_dot(exact->d, d) > 0
-                             ? v3_length(v3_cross(exact->d, d)) / b->sin_angle : INFINITY;
+    const double turn = v3_dot(exact->d, d) > 0
+                            ? v3_length(v3_cross(exact->d, d)) / b->sin_angle : INFINITY;
     vec3 e = v3_sub(o, exact->o);
     vec3 across = v3_sub(e, v3_scale(exact->d, v3_dot(e, exact->d)));
-    return fmax(angle, v3_length(across) / b->tol->origin_mm);
+    return fmax(turn, v3_length(across) / b->tol->origin_mm);
 }
 
 /* Whether pixel (x, y) is fine with face f: outside it, or inside with a ray within the
