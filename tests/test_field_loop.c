@@ -23,10 +23,12 @@ static void count_povray_starts(const char *dir)
 {
     char script[1200], text[2600];
     snprintf(script, sizeof script, "%s/countpov", dir);
-    /* a start that timed out starting its threads (the runner starts it again) is not one */
-    snprintf(text, sizeof text, "#!/bin/sh\npovray \"$@\" 2>\"$0.err.$$\"; st=$?\n"
-             "cat \"$0.err.$$\" >&2\ngrep -q 'Timed out waiting for worker thread startup' "
-             "\"$0.err.$$\" || echo start >> '%s/starts'\nrm -f \"$0.err.$$\"\nexit $st\n", dir);
+    /* a start that timed out starting its threads (the runner starts it again) is not one;
+       a start is noted first, since a process whose pictures are in is killed */
+    snprintf(text, sizeof text, "#!/bin/sh\necho start >> '%s/starts'\n"
+             "povray \"$@\" 2>\"$0.err.$$\"; st=$?\ncat \"$0.err.$$\" >&2\n"
+             "grep -q 'Timed out waiting for worker thread startup' \"$0.err.$$\" && "
+             "echo retry >> '%s/starts'\nrm -f \"$0.err.$$\"\nexit $st\n", dir, dir);
     write_text(script, text);
     chmod(script, 0755);
     setenv("LENS2POV_POVRAY", script, 1);
@@ -38,6 +40,8 @@ static int povray_starts(const char *dir)
     int n = 0;
     for (const char *p = text; p && (p = strstr(p, "start")) != NULL; p++)
         n++;
+    for (const char *p = text; p && (p = strstr(p, "retry")) != NULL; p++)
+        n--;
     free(text);
     return n;
 }

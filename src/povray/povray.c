@@ -269,6 +269,36 @@ static int reap_jobs(run *r, int *chunks, int *st, l2p_error *err)
     return ended;
 }
 
+static bool all_reported(const run *r, int t)
+{
+    for (int k = task_first(r, t); k < task_first(r, t) + task_chunks(r, t); k++)
+        if (!r->reported[k])
+            return false;
+    return true;
+}
+
+/* A task whose pictures have all been reported is done: after closing its last picture
+   POV-Ray only winds down (its threads' timed waits, a third to half a second;
+   docs/povray.md), so it is killed, not waited for. Returns how many ended so. */
+static int retire_done_tasks(run *r, int *chunks)
+{
+    int ended = 0;
+    for (int i = 0; r->notify_fd >= 0 && i < r->job_slots; i++) {
+        job *j = &r->jobs[i];
+        if (!j->pid || !all_reported(r, j->task))
+            continue;
+        kill(j->pid, SIGKILL);
+        while (waitpid(j->pid, NULL, 0) < 0 && errno == EINTR)
+            continue;
+        cleanup_untrack_child(j->pid);
+        j->pid = 0;
+        j->retries = 0;
+        *chunks += task_chunks(r, j->task);
+        ended++;
+    }
+    return ended;
+}
+
 /* How many chunks are ready, and the count once known (r->count shrinks to it). */
 static int poll_chunks(run *r, int *ready, l2p_error *err)
 {
@@ -293,7 +323,7 @@ static int schedule(run *r, l2p_error *err)
 {
     int next = 0, finished = 0, chunks_done = 0, ready = 0, st = L2P_OK;
     bool told = !r->opts->started;
-    povray_watch_frames(r);
+    povray_watch_pictures(r);
     for (int tick = 0; !st && finished < r->tasks; tick++) {
         st = poll_chunks(r, &ready, err);
         for (int i = 0; i < r->job_slots && next < r->tasks && !st &&
@@ -305,8 +335,10 @@ static int schedule(run *r, l2p_error *err)
             r->opts->started(r->opts->started_ctx);
         }
         if (!st)
-            st = povray_collect_frames(r, err);
-        const int ended = st ? 0 : reap_jobs(r, &chunks_done, &st, err);
+            st = povray_collect_pictures(r, err);
+        int ended = st ? 0 : reap_jobs(r, &chunks_done, &st, err);
+        if (!st)
+            ended += retire_done_tasks(r, &chunks_done);
         finished += ended;
         if (ended || st)
             continue;  /* start the next chunks at once */

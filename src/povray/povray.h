@@ -52,16 +52,18 @@ typedef struct povray_options {
     void (*started)(void *ctx);
     void *started_ctx;
     /* Called on the calling thread, with picture_ctx, once chunk k's picture is complete at
-       its output_exr: a sequence's frame as soon as POV-Ray has closed it (its process may
-       still fail after), any other chunk when its process has ended well. Nonzero stops the
-       run, with err set. NULL: none. */
+       its output_exr: as soon as POV-Ray has closed it (a sequence's process may still fail
+       in a later frame), or, without inotify, when its process has ended well. Nonzero stops
+       the run, with err set. NULL: none. */
     int (*picture_done)(void *ctx, int k, l2p_error *err);
     void *picture_ctx;
 } povray_options;
 
 /* Writes, for every chunk, a wrapper that includes the scene and then the chunk's camera, and
-   renders them, opts->jobs at a time, each as soon as it is ready (opts->chunks_ready). On a POV-Ray failure stops the other processes, returns
-   L2P_FAILED and puts POV-Ray's own error lines (file, line, message) in err. */
+   renders them, opts->jobs at a time, each as soon as it is ready (opts->chunks_ready). A
+   process whose pictures have all been closed is killed rather than waited for (it only
+   winds down), unless opts has user_args. On a POV-Ray failure stops the other processes,
+   returns L2P_FAILED and puts POV-Ray's own error lines (file, line, message) in err. */
 int povray_render_chunks(const povray_chunk *chunks, int count, const povray_options *opts,
                          l2p_error *err);
 
@@ -70,8 +72,8 @@ int povray_render_chunks(const povray_chunk *chunks, int count, const povray_opt
    each frame's wrapper including its own chunk's camera (chosen by frame_number), so that the
    process's start-up and exit are paid once. The first chunk's ini gives every frame's size:
    POV-Ray renders all frames of a run at one Width and Height. Each frame's picture is moved
-   to its chunk's output_exr when its process has ended, or, with opts->picture_done, as soon
-   as POV-Ray has closed it. The scene sees clock 0 and
+   to its chunk's output_exr as soon as POV-Ray has closed it (without inotify, when its
+   process has ended). The scene sees clock 0 and
    frame_number, initial_frame, final_frame, initial_clock, final_clock and clock_delta as in
    a still, but clock_on true (POV-Ray lets no scene redeclare it). Chunks take no placement
    or pov_output, opts no user_args (POV-Ray's animation is lens2pov's here) and no

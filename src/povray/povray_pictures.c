@@ -1,8 +1,8 @@
-/* Finished pictures: each chunk's picture reported once it is complete at its output_exr, a
-   sequence's frames while their POV-Ray process still runs. POV-Ray writes a frame's picture
-   once, closes it, and only then parses the next frame (its front end does both, in turn), so
-   a frame whose file has been closed is complete: developing it can overlap the frames after
-   it and POV-Ray's exit, about a quarter of a second of waiting (docs/povray.md). */
+/* Finished pictures: each chunk's picture reported once it is complete at its output_exr.
+   POV-Ray writes a picture once and closes it (a sequence's frame before it parses the next
+   frame; docs/povray.md), so a picture whose file has been closed is complete: developing it
+   can overlap the frames after it, and once a process's pictures are all in, what it still
+   does is wind down, which the runner does not wait for (povray.c). */
 #include <errno.h>
 #include <poll.h>
 #include <stdalign.h>
@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/inotify.h>
 #include <unistd.h>
+#include "povray/povray_cmd.h"
 #include "povray/povray_run.h"
 
 int povray_picture_finished(run *r, int k, const char *written, l2p_error *err)
@@ -25,9 +26,11 @@ int povray_picture_finished(run *r, int k, const char *written, l2p_error *err)
     return r->opts->picture_done ? r->opts->picture_done(r->opts->picture_ctx, k, err) : L2P_OK;
 }
 
-void povray_watch_frames(run *r)
+/* POV-Ray options of the user's may make it do more after writing its picture (a
+   Post_Frame_Command): such runs are not watched. */
+void povray_watch_pictures(run *r)
 {
-    if (!r->frames || !r->opts->picture_done || r->notify_fd >= 0)
+    if (r->opts->user_arg_count > 0 || r->notify_fd >= 0)
         return;
     const int fd = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
     if (fd >= 0 && inotify_add_watch(fd, r->work_dir, IN_CLOSE_WRITE) < 0) {
@@ -37,38 +40,46 @@ void povray_watch_frames(run *r)
     r->notify_fd = fd;
 }
 
-/* The frame of a running job whose picture POV-Ray names name (in the work folder): its
-   chunk, and in *path where it is; -1 for none. */
-static int frame_named(const run *r, const char *name, char **path)
+/* Where task t's f-th picture (1-based) is written: a sequence's frame, or a chunk's
+   output_exr. */
+static char *task_picture(const run *r, int t, int f)
+{
+    return r->frames ? povray_frame_output(r, t, f) : absolute_path(r->chunks[t].output_exr);
+}
+
+/* The chunk of a running job whose picture is named name in the work folder, with in *path
+   where it is; -1 for none. */
+static int picture_named(const run *r, const char *name, char **path)
 {
     const size_t dir = strlen(r->work_dir) + 1;
     for (int i = 0; i < r->job_slots; i++) {
         const job *j = &r->jobs[i];
         for (int f = 1; j->pid && f <= task_chunks(r, j->task); f++) {
-            char *frame = povray_frame_output(r, j->task, f);
-            if (frame && strlen(frame) > dir && strcmp(frame + dir, name) == 0) {
-                *path = frame;
+            char *picture = task_picture(r, j->task, f);
+            if (picture && strlen(picture) > dir && strncmp(picture, r->work_dir, dir - 1) == 0 &&
+                picture[dir - 1] == '/' && strcmp(picture + dir, name) == 0) {
+                *path = picture;
                 return task_first(r, j->task) + f - 1;
             }
-            free(frame);
+            free(picture);
         }
     }
     return -1;
 }
 
-int povray_collect_frames(run *r, l2p_error *err)
+int povray_collect_pictures(run *r, l2p_error *err)
 {
     if (r->notify_fd < 0)
         return L2P_OK;
     alignas(struct inotify_event) char buf[4096];
     int st = L2P_OK;
     ssize_t n;
-    /* A lost event (a full queue) only delays that frame to its process's end. */
+    /* A lost event (a full queue) only delays that picture to its process's end. */
     while (!st && (n = read(r->notify_fd, buf, sizeof buf)) > 0)
         for (char *p = buf; p < buf + n && !st;) {
             const struct inotify_event *e = (const struct inotify_event *)p;
             char *path = NULL;
-            const int k = e->len ? frame_named(r, e->name, &path) : -1;
+            const int k = e->len ? picture_named(r, e->name, &path) : -1;
             if (k >= 0)
                 st = povray_picture_finished(r, k, path, err);
             free(path);

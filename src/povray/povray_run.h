@@ -39,7 +39,7 @@ typedef struct run {
     int job_slots;
     bool writing;              /* chunks still being written: their writer draws its own bar */
     bool *reported;            /* a chunk's picture is at its output_exr and was reported */
-    int notify_fd;             /* inotify on work_dir for a sequence's frames; -1: none */
+    int notify_fd;             /* inotify on work_dir for closed pictures; -1: none */
     progress bar;
 } run;
 
@@ -90,15 +90,14 @@ int povray_out_of_memory(l2p_error *err);
    opts->picture_done, once. */
 int povray_picture_finished(run *r, int k, const char *written, l2p_error *err);
 
-/* Starts watching the work folder for a sequence's closed frames when opts->picture_done
-   wants them (nothing when inotify is not there: frames are then found as their process
-   ends). */
-void povray_watch_frames(run *r);
+/* Starts watching the work folder for closed pictures, unless the user gave POV-Ray options
+   (nothing when inotify is not there: pictures are then found as their process ends). */
+void povray_watch_pictures(run *r);
 
-/* Finishes the frames of running jobs that POV-Ray has closed since the last call. */
-int povray_collect_frames(run *r, l2p_error *err);
+/* Finishes the pictures of running jobs that POV-Ray has closed since the last call. */
+int povray_collect_pictures(run *r, l2p_error *err);
 
-/* Waits ms milliseconds, less when a watched frame is closed. */
+/* Waits ms milliseconds, less when a watched picture is closed. */
 void povray_wait_ms(const run *r, int ms);
 
 #endif
