@@ -4,11 +4,14 @@
    spheres, one colour each) must land where POV-Ray's own camera puts them. Pictures are
    64x48 at 4 samples a pixel. */
 #include <criterion/criterion.h>
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <signal.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include "image/image_io.h"
 #include "povray/scenecam.h"
 #include "support.h"
@@ -217,4 +220,52 @@ Test(scene_camera, wrapped_messages)
     cr_expect(fabs(sc.location.y - 2.0) < 1e-15 && fabs(sc.location.z + 3.0) < 1e-15);
     cr_expect(fabs(sc.forward.z - 1.0) < 1e-15 && fabs(sc.focus_distance - 3.0) < 1e-12);
     cr_expect(fabs(sc.hfov_deg - 2.0 * atan(0.665) * 180.0 / M_PI) < 1e-9);
+}
+
+/* The probe is not waited for once the scene is parsed (what POV-Ray still does, a pixel and
+   its winding down, takes about 0.4 s): a stand-in that notes its pid, runs POV-Ray and then
+   writes "ended" is gone, without having written it, when scene_camera_read returns the
+   scene's camera. With POV-Ray options of the user's (an animation's frames) it is waited
+   for. A scene that fails to parse still fails with POV-Ray's message. */
+Test(scene_camera, the_probe_ends_with_the_parse)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], fake[512], pid_path[512], ended[512], text[2200];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(fake, sizeof fake, "%s/probepov", dir);
+    snprintf(pid_path, sizeof pid_path, "%s/pid", dir);
+    snprintf(ended, sizeof ended, "%s/ended", dir);
+    snprintf(text, sizeof text, "#!/bin/sh\necho $$ > '%s'\npovray \"$@\"; st=$?\n"
+             "echo end >> '%s'\nexit $st\n", pid_path, ended);
+    write_text(fake, text);
+    chmod(fake, 0755);
+    write_text(scene, MARKERS_HEAD "camera { location <0, 1, -4> look_at <0, 1, 0> }\n");
+    setenv("LENS2POV_POVRAY", fake, 1);
+    scene_camera sc;
+    l2p_error err = {0};
+    cr_assert_eq(scene_camera_read(scene, 64, 48, &sc, &err), L2P_OK, "%s", err.text);
+    cr_expect(sc.found && fabs(sc.location.y - 1) < 1e-12 && fabs(sc.forward.z - 1) < 1e-12,
+              "camera at <%g, %g, %g> looking <%g, %g, %g>", sc.location.x, sc.location.y,
+              sc.location.z, sc.forward.x, sc.forward.y, sc.forward.z);
+    FILE *f = fopen(pid_path, "r");
+    cr_assert_not_null(f, "the stand-in never ran");
+    int pid = 0;
+    cr_expect_eq(fscanf(f, "%d", &pid), 1);
+    fclose(f);
+    cr_expect(pid > 0 && kill(pid, 0) != 0 && errno == ESRCH, "stand-in %d still there", pid);
+    cr_expect_neq(access(ended, F_OK), 0, "the probe was waited for after the parse");
+
+    /* with options of the user's, the probe runs to its end */
+    scene_frames frames;
+    char *const args[] = {"+KFF2"};
+    cr_assert_eq(scene_frames_read(scene, 64, 48, args, 1, &frames, &err), L2P_OK, "%s", err.text);
+    cr_expect_eq(frames.count, 2);
+    scene_frames_free(&frames);
+    cr_expect_eq(access(ended, F_OK), 0, "the probe with the user's options was not waited for");
+
+    /* a parse error is POV-Ray's, with the scene's line */
+    write_text(scene, MARKERS_HEAD "camera { location <0, 1, -4> look_at <0, 1, 0> }\nsphere {\n");
+    cr_expect_neq(scene_camera_read(scene, 64, 48, &sc, &err), L2P_OK);
+    cr_expect(strstr(err.text, scene) != NULL, "%s", err.text);
+    unsetenv("LENS2POV_POVRAY");
 }

@@ -7,12 +7,14 @@
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 #include "base/cleanup.h"
 #include "base/outfile.h"
@@ -67,6 +69,57 @@ typedef struct probe_args {
     char *const *user;         /* POV-Ray's own options from the command line, first */
     int user_count;
 } probe_args;
+
+/* Printed after the copy's last line: every camera statement that runs has printed. A block
+   the scene leaves open would print it too, so the parse has ended well only once POV-Ray's
+   own RENDERING line follows. */
+static const char PARSED[] = "lens2pov-parsed|", RENDERING[] = "==== [Rendering...]";
+
+/* Whether the log holds mark at or after *pos; *pos moves past it when it does, else to
+   where the next look starts. */
+static bool log_has(const char *log, const char *mark, long *pos)
+{
+    const size_t len = strlen(mark);
+    FILE *f = fopen(log, "rb");
+    if (!f || fseek(f, *pos, SEEK_SET) != 0) {
+        if (f)
+            fclose(f);
+        return false;
+    }
+    char buf[4096];
+    bool found = false;
+    for (size_t got; !found && (got = fread(buf, 1, sizeof buf, f)) >= len;) {
+        size_t i = 0;
+        while (i + len <= got && memcmp(buf + i, mark, len))
+            i++;
+        found = i + len <= got;
+        *pos += (long)(found ? i + len : i);   /* a mark cut at the block's end is read again */
+        fseek(f, *pos, SEEK_SET);
+    }
+    fclose(f);
+    return found;
+}
+
+/* The probe's wait status. With early, a probe whose parse has ended well is killed: what it
+   still does (trace a pixel, wind down, about 0.4 s) is not needed; it counts as a success. */
+static int wait_probe(pid_t pid, const char *log, bool early)
+{
+    int status = 0;
+    for (long pos = 0, stage = 0;;) {
+        const pid_t w = waitpid(pid, &status, early ? WNOHANG : 0);
+        if (w == pid || (w < 0 && errno != EINTR))
+            return status;
+        if (w == 0 && log_has(log, stage ? RENDERING : PARSED, &pos)) {
+            if (stage++ == 0)
+                continue;
+            kill(pid, SIGKILL);
+            while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+                continue;
+            return 0;
+        }
+        nanosleep(&(struct timespec){0, 5000000L}, NULL);
+    }
+}
 
 static int run_probe(const char *dir, const char *copy, const char *log, int w, int h,
                      const probe_args *pa, l2p_error *err)
@@ -125,9 +178,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     free(argv);
     if (pid < 0)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
-    int status;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
-        ;
+    const int status = wait_probe(pid, log, pa->user_count == 0);
     cleanup_untrack_child(pid);
     if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "%s: cannot run it (install Debian's povray "
@@ -173,7 +224,7 @@ static bool refused_options(const char *log, const probe_args *pa, l2p_error *er
     return true;
 }
 
-/* The copy, included by a file that first prints the frame POV-Ray is on. */
+/* The copy, included by a file that first prints the frame POV-Ray is on and last PARSED. */
 static int write_probe_files(const char *work, const char *rewritten, char *copy, char *top,
                              size_t cap, l2p_error *err)
 {
@@ -183,7 +234,7 @@ static int write_probe_files(const char *work, const char *rewritten, char *copy
     snprintf(text, sizeof text,
              "#debug concat(\"lens2pov-frame \", str(frame_number, 0, 0), \" \", "
              "str(final_frame, 0, 0), \" \", str(clock, 0, 17), \"|\\n\")\n"
-             "#include \"%s\"\n", copy);
+             "#include \"%s\"\n#debug \"%s\\n\"\n", copy, PARSED);
     int st = write_all(copy, rewritten, err);
     return st ? st : write_all(top, text, err);
 }
