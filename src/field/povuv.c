@@ -105,6 +105,11 @@ bool povuv_face_ray(const povuv_face *f, double u, double v, vec3 *o, vec3 *d)
 {
     double b[3];
     povuv_face_weights(f, u, v, b);
+    return povuv_weighted_ray(f, b, o, d);
+}
+
+bool povuv_weighted_ray(const povuv_face *f, const double b[3], vec3 *o, vec3 *d)
+{
     vec3 p1 = fv(f->p[0]), p2 = fv(f->p[1]), p3 = fv(f->p[2]);
     *o = v3_add(v3_add(v3_scale(p1, b[0]), v3_scale(p2, b[1])), v3_scale(p3, b[2]));
     const float(*n)[3] = f->n;

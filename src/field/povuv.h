@@ -34,6 +34,9 @@ void povuv_face_weights(const povuv_face *f, double u, double v, double b[3]);
    normalized Smooth_Mesh_Normal. False when the direction is not finite. */
 bool povuv_face_ray(const povuv_face *f, double u, double v, vec3 *o, vec3 *d);
 
+/* The same from (u, v)'s weights b (povuv_face_weights), when they are known already. */
+bool povuv_weighted_ray(const povuv_face *f, const double b[3], vec3 *o, vec3 *d);
+
 /* A whole mesh with POV-Ray's 10 x 10 UV grid of faces (Parse_Mesh_Camera). */
 typedef struct povuv_mesh {
     int faces;

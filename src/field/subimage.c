@@ -165,7 +165,7 @@ static bool pixel_ok(const builder *b, const povuv_face *f, int x, int y, double
     if (!b->passed[y * b->w + x])
         return false;
     vec3 o, d;
-    if (!povuv_face_ray(f, u, v, &o, &d))
+    if (!povuv_weighted_ray(f, w, &o, &d))
         return false;
     double e = ray_error(b, &b->rays[y * b->w + x], o, d);
     *worst = fmax(*worst, e);
