@@ -239,12 +239,14 @@ Test(scene_camera, the_probe_ends_with_the_parse)
              "echo end >> '%s'\nexit $st\n", pid_path, ended);
     write_text(fake, text);
     chmod(fake, 0755);
-    write_text(scene, MARKERS_HEAD "camera { location <0, 1, -4> look_at <0, 1, 0> }\n");
+    /* declared vectors: POV-Ray has to evaluate them */
+    write_text(scene, MARKERS_HEAD "camera { location Eye look_at Eye + z }\n");
     setenv("LENS2POV_POVRAY", fake, 1);
     scene_camera sc;
     l2p_error err = {0};
     cr_assert_eq(scene_camera_read(scene, 64, 48, &sc, &err), L2P_OK, "%s", err.text);
-    cr_expect(sc.found && fabs(sc.location.y - 1) < 1e-12 && fabs(sc.forward.z - 1) < 1e-12,
+    cr_expect(sc.found && fabs(sc.location.x - 1) < 1e-12 && fabs(sc.location.y - 1.5) < 1e-12 &&
+                  fabs(sc.location.z + 4) < 1e-12 && fabs(sc.forward.z - 1) < 1e-12,
               "camera at <%g, %g, %g> looking <%g, %g, %g>", sc.location.x, sc.location.y,
               sc.location.z, sc.forward.x, sc.forward.y, sc.forward.z);
     FILE *f = fopen(pid_path, "r");
@@ -264,8 +266,85 @@ Test(scene_camera, the_probe_ends_with_the_parse)
     cr_expect_eq(access(ended, F_OK), 0, "the probe with the user's options was not waited for");
 
     /* a parse error is POV-Ray's, with the scene's line */
-    write_text(scene, MARKERS_HEAD "camera { location <0, 1, -4> look_at <0, 1, 0> }\nsphere {\n");
+    write_text(scene, MARKERS_HEAD "camera { location Eye look_at Eye + z }\nsphere {\n");
     cr_expect_neq(scene_camera_read(scene, 64, 48, &sc, &err), L2P_OK);
     cr_expect(strstr(err.text, scene) != NULL, "%s", err.text);
     unsetenv("LENS2POV_POVRAY");
+}
+
+/* Cameras written as literals, each read without POV-Ray (a POV-Ray that cannot run stands in)
+   and, the same scene beside an empty povray.ini (which could have set the version), by the
+   probe: the same camera to the last bit. An #include of the scene's does not matter. */
+Test(scene_camera, a_literal_camera_is_read_as_povray_reads_it)
+{
+    static const char *const cameras[] = {
+        "#version 3.7;\ncamera { location <1, 1.5, -4> look_at <0.2, 0.5, 0> angle 40 }\n",
+        "#version 3.7;\n#include \"defs.inc\"\ncamera {\n  perspective // a comment\n"
+        "  location <0.000001234567, 2, -5> direction <0, 0, 1.5> right <-1.6, 0, 0>\n"
+        "  up y sky <0.1, 1, 0> /* and another */ look_at <1.234567890123456e-10, 2, 0> }\n",
+        "#version 3.5;\n#macro M() sphere { 0, 1 } #end\ncamera { location 3 }\n"
+        "camera { location < 0 , 1 , - 3.25e0 > look_at 0 angle 65.5 focal_point <0, 0, 0> }\n",
+    };
+    const char *dir = test_tmpdir();
+    char alone[512], probed[512], ini[600], scene[600];
+    snprintf(alone, sizeof alone, "%s/alone", dir);
+    snprintf(probed, sizeof probed, "%s/probed", dir);
+    mkdir(alone, 0755);
+    mkdir(probed, 0755);
+    snprintf(ini, sizeof ini, "%s/povray.ini", probed);
+    write_text(ini, "");
+    for (int d = 0; d < 2; d++) {
+        snprintf(scene, sizeof scene, "%s/defs.inc", d ? probed : alone);
+        write_text(scene, "#declare Unused = 1;\n");
+    }
+    for (size_t k = 0; k < sizeof cameras / sizeof *cameras; k++) {
+        char *log = scene_camera_literal_log(cameras[k], strlen(cameras[k]));
+        cr_expect_not_null(log, "camera %zu is not taken as literal", k);
+        free(log);
+        scene_camera a, b;
+        l2p_error err = {0};
+        snprintf(scene, sizeof scene, "%s/scene.pov", alone);
+        write_text(scene, cameras[k]);
+        setenv("LENS2POV_POVRAY", "/nonexistent/povray", 1);
+        cr_assert_eq(scene_camera_read(scene, 64, 48, &a, &err), L2P_OK, "%zu: %s", k, err.text);
+        unsetenv("LENS2POV_POVRAY");
+        snprintf(scene, sizeof scene, "%s/scene.pov", probed);
+        write_text(scene, cameras[k]);
+        cr_assert_eq(scene_camera_read(scene, 64, 48, &b, &err), L2P_OK, "%zu: %s", k, err.text);
+        cr_expect(a.found && b.found && a.line == b.line && a.mirrored == b.mirrored &&
+                      !memcmp(&a.location, &b.location, sizeof a.location) &&
+                      !memcmp(&a.forward, &b.forward, sizeof a.forward) &&
+                      !memcmp(&a.up, &b.up, sizeof a.up) &&
+                      a.focus_distance == b.focus_distance && a.hfov_deg == b.hfov_deg,
+                  "camera %zu: <%.17g %.17g %.17g> %.17g deg against POV-Ray's <%.17g %.17g %.17g> "
+                  "%.17g deg", k, a.location.x, a.location.y, a.location.z, a.hfov_deg,
+                  b.location.x, b.location.y, b.location.z, b.hfov_deg);
+    }
+}
+
+/* What POV-Ray has to evaluate, or whose rules it has to choose, is not read as a literal. */
+Test(scene_camera, other_cameras_are_left_to_povray)
+{
+    static const char *const cameras[] = {
+        "camera { location <0, 1, -4> }\n",                                   /* no #version */
+        "#version 3.1;\ncamera { location <0, 1, -4> }\n",                    /* old rules */
+        "#version 3.8;\ncamera { location <0, 1, -4> }\n",                    /* not 3.7's */
+        "#declare V = 3.7;\n#version V;\ncamera { location <0, 1, -4> }\n",
+        "#version 3.7;\n#if (clock > 0) camera { location <0, 1, -4> } #end\n",
+        "#version 3.7;\n#macro C() camera { location <0, 1, -4> } #end C()\n",
+        "#version 3.7;\n#if (1) #version 3.1; #end camera { location <0, 1, -4> }\n",
+        "#version 3.7;\n#declare Eye = <0, 1, -4>;\ncamera { location Eye }\n",
+        "#version 3.7;\ncamera { location <0, 1, -4> * 2 }\n",
+        "#version 3.7;\ncamera { location <0, 1> }\n",
+        "#version 3.7;\ncamera { location <0, 1, -4> rotate 30 * y }\n",
+        "#version 3.7;\ncamera { orthographic location <0, 1, -4> }\n",
+        "#version 3.7;\n#declare C = camera { location 1 }\ncamera { C }\n",
+        "#version 3.7;\ncamera { location <0, 1, -4> angle 2e9 }\n",
+        "#version 3.7;\nsphere { 0, 1 }\n",                                  /* no camera */
+    };
+    for (size_t k = 0; k < sizeof cameras / sizeof *cameras; k++) {
+        char *log = scene_camera_literal_log(cameras[k], strlen(cameras[k]));
+        cr_expect_null(log, "taken as literal: %s", cameras[k]);
+        free(log);
+    }
 }

@@ -43,8 +43,9 @@ typedef struct scene_frames {
 } scene_frames;
 
 /* scene_camera_read with POV-Ray's own options (args, given before lens2pov's): the frames
-   POV-Ray renders with them and each frame's camera. Without args and without a camera
-   statement, POV-Ray is not run (one frame, its default camera). */
+   POV-Ray renders with them and each frame's camera. Without args, POV-Ray is not run for a
+   scene without a camera statement (one frame, its default camera) nor for one whose camera
+   is literal (scene_camera_literal_log) when no ini could change its version. */
 int scene_frames_read(const char *scene_path, int width, int height, char *const *args,
                       int arg_count, scene_frames *out, l2p_error *err);
 void scene_frames_free(scene_frames *f);
@@ -57,6 +58,13 @@ int scene_frames_from_log(const char *log, size_t n, const char *scene, scene_fr
 /* The copy's text: every camera statement of text replaced by its #debug lines, on as many
    lines as the statement took, so that POV-Ray's messages keep their line numbers. */
 char *scene_camera_rewrite(const char *text, size_t n);
+
+/* What the probe's copy of text would print, frame and camera, when the scene's camera needs
+   no POV-Ray to evaluate: every camera statement outside #if, #while, #macro and other blocks,
+   its items literals (numbers, <a, b, c>, x, y, z) of location, look_at, direction, up, right,
+   sky and angle, and a literal #version from 3.5 to 3.7 in effect. NULL otherwise (and for a
+   scene without a camera statement). */
+char *scene_camera_literal_log(const char *text, size_t n);
 
 /* The camera from the #debug lines of POV-Ray's output (log, n bytes); scene names the scene
    in messages. */

@@ -239,6 +239,25 @@ static int write_probe_files(const char *work, const char *rewritten, char *copy
     return st ? st : write_all(top, text, err);
 }
 
+/* Whether an ini POV-Ray reads before the scene could set its language version (Version=):
+   a povray.ini in the scene's folder, the user's own, or one named by POVINI. Then the
+   camera's rules are POV-Ray's to find. */
+static bool settings_may_differ(const char *dir)
+{
+    const char *home = getenv("HOME"), *povini = getenv("POVINI");
+    char path[4200];
+    bool found = povini && *povini;
+    snprintf(path, sizeof path, "%s/povray.ini", dir);
+    found = found || access(path, F_OK) == 0;
+    snprintf(path, sizeof path, "%s/POVRAY.INI", dir);
+    found = found || access(path, F_OK) == 0;
+    if (home && *home) {
+        snprintf(path, sizeof path, "%s/.povray/3.7/povray.ini", home);
+        found = found || access(path, F_OK) == 0;
+    }
+    return found;
+}
+
 static int one_default_frame(const char *scene, scene_frames *out, l2p_error *err)
 {
     out->frame = calloc(1, sizeof *out->frame);
@@ -259,12 +278,23 @@ static int probe(const char *scene, const char *dir, const char *work, int w, in
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
     char *rewritten = memchr(text, '\0', n) ? NULL : scene_camera_rewrite(text, n);
     const bool no_camera = rewritten && !strcmp(rewritten, text);
-    free(text);
-    if (!rewritten)
+    if (!rewritten) {
+        free(text);
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file (or out of memory)");
+    }
     if (no_camera && pa->user_count == 0) {   /* POV-Ray's default camera, one frame */
         free(rewritten);
+        free(text);
         return one_default_frame(scene, out, err);
+    }
+    char *literal = pa->user_count || settings_may_differ(dir) ? NULL
+                                                               : scene_camera_literal_log(text, n);
+    free(text);
+    if (literal) {   /* what POV-Ray would print, without running it */
+        free(rewritten);
+        const int st = scene_frames_from_log(literal, strlen(literal), scene, out, err);
+        free(literal);
+        return st;
     }
     int st = write_probe_files(work, rewritten, copy, top, sizeof copy, err);
     free(rewritten);

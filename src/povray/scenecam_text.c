@@ -4,6 +4,7 @@
 #include "povray/scenecam.h"
 
 #include <ctype.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -217,6 +218,27 @@ static void put_item(text *t, const char *s, size_t a, size_t b, size_t e, enum 
     }
 }
 
+/* Where the item whose keyword ends at b ends: at the next keyword or directive at its brace
+   level, or at close. */
+static size_t item_end(const char *s, size_t close, size_t b)
+{
+    size_t e = b;
+    int depth = 0;
+    for (;;) {
+        e = skip_blank(s, close, e);
+        if (e >= close)
+            return e;
+        if (s[e] == '{')
+            depth++;
+        if (s[e] == '}')
+            depth--;
+        const size_t f = token_end(s, close, e);
+        if (depth == 0 && (s[e] == '#' || item_kind(s, e, f) != ITEM_NONE))
+            return e;
+        e = f;
+    }
+}
+
 static int count_lines(const char *s, size_t a, size_t b)
 {
     int lines = 0;
@@ -251,22 +273,7 @@ static void put_camera(text *t, const char *s, size_t kw, size_t open, size_t cl
             puts_(t, "#debug \"\\nlens2pov-directive|\\n\" ");
             break;
         }
-        /* The item runs to the next keyword at this brace level. */
-        size_t e = b;
-        int depth = 0;
-        for (;;) {
-            e = skip_blank(s, close, e);
-            if (e >= close)
-                break;
-            if (s[e] == '{')
-                depth++;
-            if (s[e] == '}')
-                depth--;
-            const size_t f = token_end(s, close, e);
-            if (depth == 0 && (s[e] == '#' || item_kind(s, e, f) != ITEM_NONE))
-                break;
-            e = f;
-        }
+        const size_t e = item_end(s, close, b);
         if (kind == ITEM_NONE) {
             puts_(t, "#debug \"\\nlens2pov-unknown|\\n\" ");
             break;
@@ -284,39 +291,78 @@ static void put_camera(text *t, const char *s, size_t kw, size_t open, size_t cl
         puts_(t, "\n");
 }
 
+/* ---------------------------------------------------------------- walking the scene */
+
+/* The scene's tokens in order, outside comments: the current one s[a, b) and its line, and
+   the two before it (for "= camera", "default { camera" and "#include"). */
+typedef struct walk {
+    const char *s;
+    size_t n, a, b;
+    int line;
+    size_t prev_a, prev_b, prev2_a, prev2_b;
+} walk;
+
+static walk walk_start(const char *s, size_t n) { return (walk){s, n, 0, 0, 1, 0, 0, 0, 0}; }
+
+/* Moves to the next token; false at the end. */
+static bool walk_next(walk *w)
+{
+    if (w->b > w->a) {
+        w->line += count_lines(w->s, w->a, w->b);
+        w->prev2_a = w->prev_a, w->prev2_b = w->prev_b;
+        w->prev_a = w->a, w->prev_b = w->b;
+    }
+    const size_t j = skip_blank(w->s, w->n, w->b);
+    w->line += count_lines(w->s, w->b, j);
+    if (j >= w->n)
+        return false;
+    w->a = j;
+    w->b = token_end(w->s, w->n, j);
+    return true;
+}
+
+/* Whether the token is a camera statement's keyword (not a declared camera's, "= camera",
+   nor one in "default { }"): *open gets its '{', *close what follows its '}'. */
+static bool walk_camera(const walk *w, size_t *open, size_t *close)
+{
+    const char *s = w->s;
+    const bool declared = w->prev_b > w->prev_a && s[w->prev_a] == '=';
+    const bool in_default = w->prev_b > w->prev_a && s[w->prev_a] == '{' &&
+                            is_word(s, w->prev2_a, w->prev2_b, "default");
+    if (!is_word(s, w->a, w->b, "camera") || declared || in_default)
+        return false;
+    *open = skip_blank(s, w->n, w->b);
+    if (*open >= w->n || s[*open] != '{')
+        return false;
+    *close = block_end(s, w->n, *open);
+    return true;
+}
+
+/* Past a camera statement that ends before close, which counts as no token. */
+static void walk_past(walk *w, size_t close)
+{
+    w->line += count_lines(w->s, w->a, close);
+    w->a = w->b = close;
+    w->prev_a = w->prev_b = 0;
+}
+
+/* The directive word of "# WORD", if the token is one. */
+static bool walk_directive(const walk *w)
+{
+    return w->prev_b == w->prev_a + 1 && w->s[w->prev_a] == '#';
+}
+
 char *scene_camera_rewrite(const char *s, size_t n)
 {
     text t = {0};
-    size_t copied = 0, i = 0;
-    int line = 1, index = 0;
-    size_t prev_a = 0, prev_b = 0;      /* the last token, for "= camera" and "default {" */
-    size_t prev2_a = 0, prev2_b = 0;
-    while (i < n) {
-        const size_t j = skip_blank(s, n, i);
-        line += count_lines(s, i, j);
-        if ((i = j) >= n)
-            break;
-        const size_t e = token_end(s, n, i);
-        const bool declared = prev_b > prev_a && s[prev_a] == '=';
-        const bool in_default = prev_b > prev_a && s[prev_a] == '{' &&
-                                is_word(s, prev2_a, prev2_b, "default");
-        if (is_word(s, i, e, "camera") && !declared && !in_default) {
-            const size_t open = skip_blank(s, n, e);
-            if (open < n && s[open] == '{') {
-                const size_t close = block_end(s, n, open);
-                put(&t, s + copied, i - copied);
-                put_camera(&t, s, i, open, close > open ? close - 1 : open, index++, line);
-                line += count_lines(s, i, close);
-                copied = i = close;
-                prev_a = prev_b = 0;
-                continue;
-            }
+    size_t copied = 0, open, close;
+    int index = 0;
+    for (walk w = walk_start(s, n); walk_next(&w);)
+        if (walk_camera(&w, &open, &close)) {
+            put(&t, s + copied, w.a - copied);
+            put_camera(&t, s, w.a, open, close > open ? close - 1 : open, index++, w.line);
+            walk_past(&w, copied = close);
         }
-        line += count_lines(s, i, e);
-        prev2_a = prev_a, prev2_b = prev_b;
-        prev_a = i, prev_b = e;
-        i = e;
-    }
     put(&t, s + copied, n - copied);
     if (!t.s && !t.failed)
         puts_(&t, "");
@@ -329,24 +375,12 @@ char *scene_camera_rewrite(const char *s, size_t n)
 
 void scene_text_includes(const char *s, size_t n, scene_include_visit visit, void *ctx)
 {
-    size_t i = 0, prev_a = 0, prev_b = 0, prev2_a = 0, prev2_b = 0;
-    int line = 1;
-    while (i < n) {
-        const size_t j = skip_blank(s, n, i);
-        line += count_lines(s, i, j);
-        if ((i = j) >= n)
-            break;
-        const size_t e = token_end(s, n, i);
-        /* '#' 'include' "NAME": the name without its quotes (no escapes in a file name). */
-        if (s[i] == '"' && e - i >= 2 && s[e - 1] == '"' && is_word(s, prev_a, prev_b, "include") &&
-            prev2_b == prev2_a + 1 && s[prev2_a] == '#' &&
-            !visit(s + i + 1, e - i - 2, line, ctx))
+    /* '#' 'include' "NAME": the name without its quotes (no escapes in a file name). */
+    for (walk w = walk_start(s, n); walk_next(&w);)
+        if (s[w.a] == '"' && w.b - w.a >= 2 && s[w.b - 1] == '"' &&
+            is_word(s, w.prev_a, w.prev_b, "include") && w.prev2_b == w.prev2_a + 1 &&
+            s[w.prev2_a] == '#' && !visit(s + w.a + 1, w.b - w.a - 2, w.line, ctx))
             return;
-        line += count_lines(s, i, e);
-        prev2_a = prev_a, prev2_b = prev_b;
-        prev_a = i, prev_b = e;
-        i = e;
-    }
 }
 
 bool scene_text_has_camera(const char *s, size_t n, int *line)
@@ -362,4 +396,177 @@ bool scene_text_has_camera(const char *s, size_t n, int *line)
     *line = changed ? count_lines(s, 0, k) + 1 : 0;
     free(copy);
     return changed;
+}
+
+/* ---------------------------------------------------------------- literal cameras */
+
+/* A number as POV-Ray writes one: digits with an optional point and exponent, no sign (a sign
+   is an operator), at s[*i] before e; *i moves past it. */
+static bool literal_number(const char *s, size_t e, size_t *i, double *v)
+{
+    size_t k = *i, digits = 0;
+    while (k < e && isdigit((unsigned char)s[k]))
+        k++, digits++;
+    if (k < e && s[k] == '.')
+        for (k++; k < e && isdigit((unsigned char)s[k]); k++)
+            digits++;
+    if (!digits)
+        return false;
+    if (k < e && (s[k] == 'e' || s[k] == 'E')) {
+        size_t x = k + 1;
+        if (x < e && (s[x] == '+' || s[x] == '-'))
+            x++;
+        if (x >= e || !isdigit((unsigned char)s[x]))
+            return false;
+        while (x < e && isdigit((unsigned char)s[x]))
+            x++;
+        k = x;
+    }
+    char buf[64];
+    if (k - *i >= sizeof buf)
+        return false;
+    memcpy(buf, s + *i, k - *i);
+    buf[k - *i] = '\0';
+    *v = strtod(buf, NULL);
+    *i = k;
+    return true;
+}
+
+/* A signed literal number, blanks allowed around the sign. */
+static bool signed_number(const char *s, size_t e, size_t *i, double *v)
+{
+    size_t k = skip_blank(s, e, *i);
+    const bool minus = k < e && s[k] == '-';
+    if (k < e && (s[k] == '-' || s[k] == '+'))
+        k = skip_blank(s, e, k + 1);
+    if (!literal_number(s, e, &k, v))
+        return false;
+    *v = minus ? -*v : *v;
+    *i = k;
+    return true;
+}
+
+/* The value of an item's expression s[b, e) when it is a literal: a vector <a, b, c>, a
+   number (a vector's three components, as POV-Ray promotes it) or a signed x, y or z; an
+   angle only a number. */
+static bool literal_value(const char *s, size_t b, size_t e, bool vector, double v[3])
+{
+    size_t i = skip_blank(s, e, b);
+    if (vector && i < e && s[i] == '<') {
+        for (int k = 0; k < 3; k++) {
+            i++;   /* past '<' or ',' */
+            if (!signed_number(s, e, &i, &v[k]))
+                return false;
+            i = skip_blank(s, e, i);
+            if (i >= e || s[i] != (k < 2 ? ',' : '>'))
+                return false;
+        }
+        return skip_blank(s, e, i + 1) == e;
+    }
+    const size_t sign = i;
+    if (i < e && (s[i] == '-' || s[i] == '+'))
+        i = skip_blank(s, e, i + 1);
+    const size_t t = i < e ? token_end(s, e, i) : i;
+    if (vector && t == i + 1 && (s[i] == 'x' || s[i] == 'y' || s[i] == 'z')) {
+        v[0] = v[1] = v[2] = 0;
+        v[s[i] - 'x'] = s[sign] == '-' ? -1 : 1;
+        return skip_blank(s, e, t) == e;
+    }
+    i = sign;
+    if (!signed_number(s, e, &i, &v[0]))
+        return false;
+    v[1] = v[2] = v[0];
+    return skip_blank(s, e, i) == e;
+}
+
+/* The messages the probe's copy would print for one camera statement (put_camera) whose items
+   are all literals of location, look_at, direction, up, right, sky, angle and perspective;
+   false for any other. Numbers are printed as POV-Ray's str(v, 0, 17) prints them ("%.17f"),
+   so that they are read back as from POV-Ray; beyond 1e9 that takes too many digits. */
+static bool literal_camera(text *t, const char *s, size_t open, size_t close, int index,
+                           int line, double version)
+{
+    char msg[256];
+    snprintf(msg, sizeof msg, "\nlens2pov-camera %d %d|\n\nlens2pov-version %.3f|\n", index, line,
+             version);
+    puts_(t, msg);
+    for (size_t i = skip_blank(s, close, open + 1); i < close;) {
+        const size_t a = i, b = token_end(s, close, i);
+        const enum item_kind kind = item_kind(s, a, b);
+        if (s[a] == '#' || kind == ITEM_NONE || kind == ITEM_TRANSFORM ||
+            (kind == ITEM_TYPE && !is_word(s, a, b, "perspective")))
+            return false;
+        const size_t e = item_end(s, close, b);
+        double v[3];
+        if (kind == ITEM_VECTOR || kind == ITEM_ANGLE) {
+            if (!literal_value(s, b, e, kind == ITEM_VECTOR, v) ||
+                !(fabs(v[0]) < 1e9 && fabs(v[1]) < 1e9 && fabs(v[2]) < 1e9))
+                return false;
+            if (kind == ITEM_VECTOR)
+                snprintf(msg, sizeof msg, "\nlens2pov-%.*s %.17f %.17f %.17f|\n", (int)(b - a),
+                         s + a, v[0], v[1], v[2]);
+            else
+                snprintf(msg, sizeof msg, "\nlens2pov-angle %.17f|\n", v[0]);
+            puts_(t, msg);
+        } else if (kind == ITEM_TYPE) {
+            puts_(t, "\nlens2pov-type perspective|\n");
+        }
+        i = e;
+    }
+    puts_(t, "\nlens2pov-end|\n");
+    return true;
+}
+
+/* Directives that open a block up to its #end. */
+static bool opens_block(const char *s, size_t a, size_t b)
+{
+    static const char *const words[] = {"if", "ifdef", "ifndef", "switch", "while", "for", "macro"};
+    for (size_t k = 0; k < sizeof words / sizeof *words; k++)
+        if (is_word(s, a, b, words[k]))
+            return true;
+    return false;
+}
+
+/* Follows the directive whose word is the walk's token: the depth of blocks, and a literal
+   #version; false for a #version that is no literal or stands in a block. */
+static bool follow_directive(const walk *w, int *depth, double *version)
+{
+    const char *s = w->s;
+    if (opens_block(s, w->a, w->b))
+        ++*depth;
+    else if (is_word(s, w->a, w->b, "end"))
+        return --*depth >= 0;
+    else if (is_word(s, w->a, w->b, "version")) {
+        size_t k = skip_blank(s, w->n, w->b);
+        if (*depth || !literal_number(s, w->n, &k, version))
+            return false;
+        k = skip_blank(s, w->n, k);
+        return k < w->n && s[k] == ';';
+    }
+    return true;
+}
+
+char *scene_camera_literal_log(const char *s, size_t n)
+{
+    text t = {0};
+    puts_(&t, "\nlens2pov-frame 0 0 0|\n");
+    size_t open, close;
+    int index = 0, depth = 0;
+    double version = 0;   /* none yet: POV-Ray's then comes from its settings */
+    bool ok = true;
+    for (walk w = walk_start(s, n); ok && walk_next(&w);) {
+        if (walk_directive(&w))
+            ok = follow_directive(&w, &depth, &version);
+        if (ok && walk_camera(&w, &open, &close)) {
+            ok = depth == 0 && version >= 3.5 && version <= 3.7 &&
+                 literal_camera(&t, s, open, close > open ? close - 1 : open, index++, w.line,
+                                version);
+            walk_past(&w, close);
+        }
+    }
+    if (!ok || t.failed || index == 0) {
+        free(t.s);
+        return NULL;
+    }
+    return t.s;
 }
