@@ -225,8 +225,9 @@ Test(scene_camera, wrapped_messages)
 /* The probe is not waited for once the scene is parsed (what POV-Ray still does, a pixel and
    its winding down, takes about 0.4 s): a stand-in that notes its pid, runs POV-Ray and then
    writes "ended" is gone, without having written it, when scene_camera_read returns the
-   scene's camera. With POV-Ray options of the user's (an animation's frames) it is waited
-   for. A scene that fails to parse still fails with POV-Ray's message. */
+   scene's camera. With POV-Ray options of the user's (an animation's frames), or a povray.ini
+   that makes POV-Ray animate, it is waited for. A scene that fails to parse still fails with
+   POV-Ray's message. */
 Test(scene_camera, the_probe_ends_with_the_parse)
 {
     const char *dir = test_tmpdir();
@@ -265,6 +266,17 @@ Test(scene_camera, the_probe_ends_with_the_parse)
     scene_frames_free(&frames);
     cr_expect_eq(access(ended, F_OK), 0, "the probe with the user's options was not waited for");
 
+    /* an ini that makes POV-Ray animate: every frame is read, the probe runs to its end */
+    char ini[600];
+    snprintf(ini, sizeof ini, "%s/povray.ini", dir);
+    write_text(ini, "Initial_Frame=1\nFinal_Frame=3\n");
+    unlink(ended);
+    cr_assert_eq(scene_frames_read(scene, 64, 48, NULL, 0, &frames, &err), L2P_OK, "%s", err.text);
+    cr_expect_eq(frames.count, 3);
+    scene_frames_free(&frames);
+    cr_expect_eq(access(ended, F_OK), 0, "an animation's probe was not waited for");
+    unlink(ini);
+
     /* a parse error is POV-Ray's, with the scene's line */
     write_text(scene, MARKERS_HEAD "camera { location Eye look_at Eye + z }\nsphere {\n");
     cr_expect_neq(scene_camera_read(scene, 64, 48, &sc, &err), L2P_OK);
@@ -283,9 +295,13 @@ Test(scene_camera, a_literal_camera_is_read_as_povray_reads_it)
         "  location <0.000001234567, 2, -5> direction <0, 0, 1.5> right <-1.6, 0, 0>\n"
         "  up y sky <0.1, 1, 0> /* and another */ look_at <1.234567890123456e-10, 2, 0> }\n",
         "#version 3.5;\n#macro M() sphere { 0, 1 } #end\ncamera { location 3 }\n"
-        "camera { location < 0 , 1 , - 3.25e0 > look_at 0 angle 65.5 focal_point <0, 0, 0> }\n",
+        "camera { location < -0 , 1 , - 3.25e0 > look_at <-0, 0, -0> angle 65.5 focal_point 0 }\n",
     };
     const char *dir = test_tmpdir();
+    /* no ini of the user's (HOME, POVINI) may keep the scenes from being read as literals */
+    char *home = getenv("HOME") ? strdup(getenv("HOME")) : NULL;
+    setenv("HOME", dir, 1);
+    unsetenv("POVINI");
     char alone[512], probed[512], ini[600], scene[600];
     snprintf(alone, sizeof alone, "%s/alone", dir);
     snprintf(probed, sizeof probed, "%s/probed", dir);
@@ -320,6 +336,9 @@ Test(scene_camera, a_literal_camera_is_read_as_povray_reads_it)
                   "%.17g deg", k, a.location.x, a.location.y, a.location.z, a.hfov_deg,
                   b.location.x, b.location.y, b.location.z, b.hfov_deg);
     }
+    if (home)
+        setenv("HOME", home, 1);
+    free(home);
 }
 
 /* What POV-Ray has to evaluate, or whose rules it has to choose, is not read as a literal. */

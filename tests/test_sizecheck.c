@@ -48,30 +48,39 @@ static void workspace_size(const char *dir, double *bytes, double *faces)
     closedir(d);
 }
 
-/* Has every POV-Ray process that lens2pov starts write its peak resident size, in kilobytes
-   (GNU time), on a line of dir/peaks. lens2pov kills a process once its pictures are in, so
-   GNU time runs in the background of the script it kills, and notes the peak when POV-Ray
-   has wound down (wait_for_peaks). */
+/* Has every POV-Ray process that lens2pov starts note its start on a line of dir/starts and
+   write its peak resident size, in kilobytes (GNU time), on a line of dir/peaks. lens2pov
+   kills a process once its pictures are in, so GNU time runs in the background of the script
+   it kills, and notes the peak when POV-Ray has wound down (wait_for_peaks). */
 static void record_povray_peaks(const char *dir)
 {
     char script[1200], text[2600];
     snprintf(script, sizeof script, "%s/timepov", dir);
     snprintf(text, sizeof text,
-             "#!/bin/sh\n/usr/bin/time -a -o '%s/peaks' -f '%%M' povray \"$@\" &\nwait $!\n", dir);
+             "#!/bin/sh\necho s >> '%s/starts'\n"
+             "/usr/bin/time -a -o '%s/peaks' -f '%%M' povray \"$@\" &\nwait $!\n", dir, dir);
     write_text(script, text);
     chmod(script, 0755);
     setenv("LENS2POV_POVRAY", script, 1);
 }
 
-/* dir/peaks once it has n lines, or after 30 s. */
-static char *wait_for_peaks(const char *dir, int n)
+static int count_lines(const char *text)
+{
+    int lines = 0;
+    for (const char *p = text; p && (p = strchr(p, '\n')) != NULL; p++)
+        lines++;
+    return lines;
+}
+
+/* dir/peaks once it has a line for every start in dir/starts, or after 30 s. */
+static char *wait_for_peaks(const char *dir)
 {
     for (int waited = 0;; waited += 50) {
         char *peaks = read_text(tmp_path(dir, "peaks"), NULL);
-        int lines = 0;
-        for (const char *p = peaks; p && (p = strchr(p, '\n')) != NULL; p++)
-            lines++;
-        if (lines >= n || waited >= 30000)
+        char *starts = read_text(tmp_path(dir, "starts"), NULL);
+        const bool all = count_lines(peaks) >= count_lines(starts);
+        free(starts);
+        if (all || waited >= 30000)
             return peaks;
         free(peaks);
         nanosleep(&(struct timespec){0, 50000000L}, NULL);
@@ -113,7 +122,7 @@ Test(sizecheck, a_field_render_stays_within_its_estimate)
     cr_expect_leq(faces, e.faces);
     cr_expect_leq(bytes, e.table_bytes + e.renders_bytes);
     cr_expect_leq((double)sb.st_size, e.csv_bytes);
-    char *peaks = wait_for_peaks(dir, 2);
+    char *peaks = wait_for_peaks(dir);
     cr_assert_not_null(peaks, "no POV-Ray process noted its peak");
     int processes = 0;
     for (char *p = peaks, *end; *p; p = end, processes++) {

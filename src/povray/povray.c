@@ -279,17 +279,21 @@ static bool all_reported(const run *r, int t)
 
 /* A task whose pictures have all been reported is done: after closing its last picture
    POV-Ray only winds down (its threads' timed waits, a third to half a second;
-   docs/povray.md), so it is killed, not waited for. Returns how many ended so. */
-static int retire_done_tasks(run *r, int *chunks)
+   docs/povray.md), so it is killed, not waited for; had it already failed, that is the
+   run's failure (*st) as when reap_jobs finds it. Returns how many ended so. */
+static int retire_done_tasks(run *r, int *chunks, int *st, l2p_error *err)
 {
     int ended = 0;
     for (int i = 0; r->notify_fd >= 0 && i < r->job_slots; i++) {
         job *j = &r->jobs[i];
         if (!j->pid || !all_reported(r, j->task))
             continue;
+        int status = 0;
         kill(j->pid, SIGKILL);
-        while (waitpid(j->pid, NULL, 0) < 0 && errno == EINTR)
+        while (waitpid(j->pid, &status, 0) < 0 && errno == EINTR)
             continue;
+        if (!*st && WIFEXITED(status) && WEXITSTATUS(status) != 0)
+            *st = explain_failure(r, j, status, err);
         cleanup_untrack_child(j->pid);
         j->pid = 0;
         j->retries = 0;
@@ -338,7 +342,7 @@ static int schedule(run *r, l2p_error *err)
             st = povray_collect_pictures(r, err);
         int ended = st ? 0 : reap_jobs(r, &chunks_done, &st, err);
         if (!st)
-            ended += retire_done_tasks(r, &chunks_done);
+            ended += retire_done_tasks(r, &chunks_done, &st, err);
         finished += ended;
         if (ended || st)
             continue;  /* start the next chunks at once */

@@ -3,6 +3,7 @@
    camera from what it printed (scenecam.c). */
 #include "povray/scenecam.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
@@ -70,10 +71,55 @@ typedef struct probe_args {
     int user_count;
 } probe_args;
 
-/* Printed after the copy's last line: every camera statement that runs has printed. A block
-   the scene leaves open would print it too, so the parse has ended well only once POV-Ray's
-   own RENDERING line follows. */
-static const char PARSED[] = "lens2pov-parsed|", RENDERING[] = "==== [Rendering...]";
+/* Whether the ini at path has a setting, outside its ';' comments, that names frames, the
+   clock or the language version (Initial_Frame, Clock, Version, +KFF, +MV, ...), or another
+   ini. A missing file has none. */
+static bool ini_sets_frames_or_version(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    bool found = false;
+    char line[1024];
+    while (f && !found && fgets(line, sizeof line, f)) {
+        line[strcspn(line, ";")] = '\0';
+        for (char *c = line; *c; c++)
+            *c = (char)tolower((unsigned char)*c);
+        found = strstr(line, "frame") || strstr(line, "clock") || strstr(line, "version") ||
+                strstr(line, "subset") || strstr(line, "+k") || strstr(line, "-k") ||
+                strstr(line, "+mv") || strstr(line, ".ini");
+    }
+    if (f)
+        fclose(f);
+    return found;
+}
+
+/* Whether an ini POV-Ray reads before the scene could set its language version or make it
+   animate: a povray.ini in the scene's folder, the user's own, one named by POVINI, or a
+   system-wide one with such a setting (Debian's has none). Then the camera's rules and frames
+   are POV-Ray's to find. */
+static bool settings_may_differ(const char *dir)
+{
+    const char *home = getenv("HOME"), *povini = getenv("POVINI");
+    char path[4200];
+    bool found = povini && *povini;
+    snprintf(path, sizeof path, "%s/povray.ini", dir);
+    found = found || access(path, F_OK) == 0;
+    snprintf(path, sizeof path, "%s/POVRAY.INI", dir);
+    found = found || access(path, F_OK) == 0;
+    if (home && *home) {
+        snprintf(path, sizeof path, "%s/.povray/3.7/povray.ini", home);
+        found = found || access(path, F_OK) == 0;
+    }
+    return found || ini_sets_frames_or_version("/etc/povray/3.7/povray.ini");
+}
+
+/* The marks of a probe that has done its work, in the order it prints them: the frame line
+   of a still (frame 0 of final frame 0; an ini can make POV-Ray render an animation even
+   without options), PARSED after the copy's last line (every camera statement that runs has
+   printed), and POV-Ray's own RENDERING line, since a block the scene leaves open would print
+   PARSED too and fail only then. */
+static const char PARSED[] = "lens2pov-parsed|";
+static const char *const DONE_MARKS[] = {"lens2pov-frame 0 0 ", PARSED, "==== [Rendering...]"};
+enum { DONE_STAGES = sizeof DONE_MARKS / sizeof *DONE_MARKS };
 
 /* Whether the log holds mark at or after *pos; *pos moves past it when it does, else to
    where the next look starts. */
@@ -100,17 +146,20 @@ static bool log_has(const char *log, const char *mark, long *pos)
     return found;
 }
 
-/* The probe's wait status. With early, a probe whose parse has ended well is killed: what it
-   still does (trace a pixel, wind down, about 0.4 s) is not needed; it counts as a success. */
+/* The probe's wait status (exit status 1 when it cannot be had). With early, a still whose
+   parse has ended well is killed: what it still does (trace a pixel, wind down, about 0.4 s)
+   is not needed; it counts as a success. */
 static int wait_probe(pid_t pid, const char *log, bool early)
 {
     int status = 0;
     for (long pos = 0, stage = 0;;) {
         const pid_t w = waitpid(pid, &status, early ? WNOHANG : 0);
-        if (w == pid || (w < 0 && errno != EINTR))
+        if (w == pid)
             return status;
-        if (w == 0 && log_has(log, stage ? RENDERING : PARSED, &pos)) {
-            if (stage++ == 0)
+        if (w < 0 && errno != EINTR)
+            return 1 << 8;
+        if (w == 0 && log_has(log, DONE_MARKS[stage], &pos)) {
+            if (++stage < DONE_STAGES)
                 continue;
             kill(pid, SIGKILL);
             while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
@@ -237,25 +286,6 @@ static int write_probe_files(const char *work, const char *rewritten, char *copy
              "#include \"%s\"\n#debug \"%s\\n\"\n", copy, PARSED);
     int st = write_all(copy, rewritten, err);
     return st ? st : write_all(top, text, err);
-}
-
-/* Whether an ini POV-Ray reads before the scene could set its language version (Version=):
-   a povray.ini in the scene's folder, the user's own, or one named by POVINI. Then the
-   camera's rules are POV-Ray's to find. */
-static bool settings_may_differ(const char *dir)
-{
-    const char *home = getenv("HOME"), *povini = getenv("POVINI");
-    char path[4200];
-    bool found = povini && *povini;
-    snprintf(path, sizeof path, "%s/povray.ini", dir);
-    found = found || access(path, F_OK) == 0;
-    snprintf(path, sizeof path, "%s/POVRAY.INI", dir);
-    found = found || access(path, F_OK) == 0;
-    if (home && *home) {
-        snprintf(path, sizeof path, "%s/.povray/3.7/povray.ini", home);
-        found = found || access(path, F_OK) == 0;
-    }
-    return found;
 }
 
 static int one_default_frame(const char *scene, scene_frames *out, l2p_error *err)

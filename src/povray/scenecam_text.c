@@ -502,9 +502,9 @@ static bool literal_camera(text *t, const char *s, size_t open, size_t close, in
             if (!literal_value(s, b, e, kind == ITEM_VECTOR, v) ||
                 !(fabs(v[0]) < 1e9 && fabs(v[1]) < 1e9 && fabs(v[2]) < 1e9))
                 return false;
-            if (kind == ITEM_VECTOR)
+            if (kind == ITEM_VECTOR)   /* <0,0,0> + (EXPR): a zero's sign is lost */
                 snprintf(msg, sizeof msg, "\nlens2pov-%.*s %.17f %.17f %.17f|\n", (int)(b - a),
-                         s + a, v[0], v[1], v[2]);
+                         s + a, 0.0 + v[0], 0.0 + v[1], 0.0 + v[2]);
             else
                 snprintf(msg, sizeof msg, "\nlens2pov-angle %.17f|\n", v[0]);
             puts_(t, msg);
