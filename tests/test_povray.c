@@ -547,9 +547,10 @@ Test(povray, a_sequence_reports_each_frame_when_povray_has_closed_it)
 /* Once every picture of a process is in, the runner does not wait for the process to end
    (POV-Ray only winds down after its last picture, a third to half a second): the stand-in
    notes its pid, runs POV-Ray, then writes dir/ended. Both a sequence and a chunk return
-   with their pictures, the stand-in gone before it could write dir/ended. With POV-Ray
-   options of the user's (which might make POV-Ray do more after its picture) the run waits
-   for the process to end. */
+   with their pictures, the stand-in gone before it could write dir/ended; so with POV-Ray
+   options of the user's that leave it nothing more to do (quality, threads, Declare=). With
+   others (which might make POV-Ray do more after its picture) the run waits for the process
+   to end. */
 Test(povray, a_process_whose_pictures_are_in_is_not_waited_for)
 {
     char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
@@ -584,12 +585,17 @@ Test(povray, a_process_whose_pictures_are_in_is_not_waited_for)
         cr_expect_neq(access(ended, F_OK), 0, "the run waited for the stand-in's end");
         cr_expect(waitpid(-1, NULL, WNOHANG) < 0 && errno == ECHILD, "a child is left");
     }
-    /* POV-Ray options of the user's: the process is waited for */
-    char *const user_args[] = {"+Q9"};
-    o.user_args = user_args;
+    /* POV-Ray options of the user's that leave it nothing to do after its pictures: not
+       waited for; any other: waited for */
+    char *const plain[] = {"+Q9", "Declare=Lens2pov_Test=1", "+WT1"}, *const other[] = {"+GD"};
+    o.user_args = plain;
+    o.user_arg_count = 3;
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
+    cr_expect_neq(access(ended, F_OK), 0, "the run waited with %s", plain[1]);
+    o.user_args = other;
     o.user_arg_count = 1;
     cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
-    cr_expect_eq(access(ended, F_OK), 0, "the run did not wait with options of the user's");
+    cr_expect_eq(access(ended, F_OK), 0, "the run did not wait with %s", other[0]);
     free_fixture(&fx);
     free(scene), free(script), free(pidfile), free(ended), free(text);
     remove_tree(dir);

@@ -66,6 +66,32 @@ int povargs_check(char *const *args, int count, l2p_error *err)
 }
 
 /* head + path, the path made absolute when it is relative and exists here. */
+static bool ends_with_pictures(const char *a)
+{
+    static const char *const keys[] = {"Declare", "Initial_Frame", "Final_Frame",
+                                       "Initial_Clock", "Final_Clock", "Subset_Start_Frame",
+                                       "Subset_End_Frame", "Cyclic_Animation", "Quality",
+                                       "Work_Threads"};
+    const char *eq = strchr(a, '=');
+    if ((a[0] == '+' || a[0] == '-') && a[1]) {
+        const char c0 = (char)toupper((unsigned char)a[1]), c1 = (char)toupper((unsigned char)a[2]);
+        return c0 == 'K' || c0 == 'Q' || (c0 == 'W' && c1 == 'T') ||
+               ((c0 == 'S' || c0 == 'E') && c1 == 'F');
+    }
+    for (size_t i = 0; eq && i < sizeof keys / sizeof keys[0]; i++)
+        if (strlen(keys[i]) == (size_t)(eq - a) && !strncasecmp(a, keys[i], (size_t)(eq - a)))
+            return true;
+    return false;
+}
+
+bool povargs_end_with_pictures(char *const *args, int count)
+{
+    for (int i = 0; i < count; i++)
+        if (!ends_with_pictures(args[i]))
+            return false;
+    return true;
+}
+
 static char *resolved(const char *head, size_t head_len, const char *path)
 {
     char cwd[4096];

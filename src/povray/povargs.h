@@ -4,6 +4,7 @@
 #ifndef LENS2POV_POVARGS_H
 #define LENS2POV_POVARGS_H
 
+#include <stdbool.h>
 #include "base/error.h"
 
 /* L2P_BAD_INPUT, naming "--" and the option, for an option that sets the image's size, its
@@ -16,6 +17,12 @@ int povargs_check(char *const *args, int count, l2p_error *err);
    that exist here. NULL-terminated, malloc'd (povargs_free); NULL out of memory. */
 char **povargs_resolve(char *const *args, int count);
 void povargs_free(char **args);
+
+/* Whether the options leave POV-Ray nothing to do once it has written its pictures, so that
+   it need not be waited for: each an animation or subset-of-frames option (+K..., +SF, +EF,
+   Initial_Frame=, ...), a quality or thread count (+Q, +WT) or a Declare=. Any other (an ini
+   named alone, a Post_Frame_Command=, ...) might. */
+bool povargs_end_with_pictures(char *const *args, int count);
 
 /* The digits POV-Ray pads a frame number to: those of the final frame. */
 int povargs_frame_digits(int final_frame);

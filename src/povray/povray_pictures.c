@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/inotify.h>
 #include <unistd.h>
+#include "povray/povargs.h"
 #include "povray/povray_cmd.h"
 #include "povray/povray_run.h"
 
@@ -27,10 +28,12 @@ int povray_picture_finished(run *r, int k, const char *written, l2p_error *err)
 }
 
 /* POV-Ray options of the user's may make it do more after writing its picture (a
-   Post_Frame_Command): such runs are not watched. */
+   Post_Frame_Command): runs with others than povargs_end_with_pictures allows are not
+   watched. */
 void povray_watch_pictures(run *r)
 {
-    if (r->opts->user_arg_count > 0 || r->notify_fd >= 0)
+    if (!povargs_end_with_pictures(r->opts->user_args, r->opts->user_arg_count) ||
+        r->notify_fd >= 0)
         return;
     const int fd = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
     if (fd >= 0 && inotify_add_watch(fd, r->work_dir, IN_CLOSE_WRITE) < 0) {

@@ -91,7 +91,8 @@ int povray_out_of_memory(l2p_error *err);
 int povray_picture_finished(run *r, int k, const char *written, l2p_error *err);
 
 /* Starts watching the work folder for closed pictures, unless the user gave POV-Ray options
-   (nothing when inotify is not there: pictures are then found as their process ends). */
+   that might make it do more after them (nothing when inotify is not there: pictures are
+   then found as their process ends). */
 void povray_watch_pictures(run *r);
 
 /* Finishes the pictures of running jobs that POV-Ray has closed since the last call. */

@@ -20,6 +20,7 @@
 #include "base/cleanup.h"
 #include "base/outfile.h"
 #include "base/tempdir.h"
+#include "povray/povargs.h"
 #include "povray/povray_log.h"
 
 /* The whole file, NUL-terminated (malloc'd); *n its length. */
@@ -227,7 +228,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     free(argv);
     if (pid < 0)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
-    const int status = wait_probe(pid, log, pa->user_count == 0);
+    const int status = wait_probe(pid, log, povargs_end_with_pictures(pa->user, pa->user_count));
     cleanup_untrack_child(pid);
     if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "%s: cannot run it (install Debian's povray "
