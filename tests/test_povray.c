@@ -548,7 +548,7 @@ Test(povray, a_sequence_reports_each_frame_when_povray_has_closed_it)
    (POV-Ray only winds down after its last picture, a third to half a second): the stand-in
    notes its pid, runs POV-Ray, then writes dir/ended. Both a sequence and a chunk return
    with their pictures, the stand-in gone before it could write dir/ended; so with POV-Ray
-   options of the user's that leave it nothing more to do (quality, threads, Declare=). With
+   options of the user's that leave it nothing more to do (quality, threads, Declare=, +L). With
    others (which might make POV-Ray do more after its picture) the run waits for the process
    to end. */
 Test(povray, a_process_whose_pictures_are_in_is_not_waited_for)
@@ -587,9 +587,10 @@ Test(povray, a_process_whose_pictures_are_in_is_not_waited_for)
     }
     /* POV-Ray options of the user's that leave it nothing to do after its pictures: not
        waited for; any other: waited for */
-    char *const plain[] = {"+Q9", "Declare=Lens2pov_Test=1", "+WT1"}, *const other[] = {"+GD"};
+    char *const plain[] = {"+Q9", "Declare=Lens2pov_Test=1", "+WT1", "+L/tmp"};
+    char *const other[] = {"+GD"};
     o.user_args = plain;
-    o.user_arg_count = 3;
+    o.user_arg_count = 4;
     cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_OK, "%s", err.text);
     cr_expect_neq(access(ended, F_OK), 0, "the run waited with %s", plain[1]);
     o.user_args = other;

@@ -71,11 +71,11 @@ static bool ends_with_pictures(const char *a)
     static const char *const keys[] = {"Declare", "Initial_Frame", "Final_Frame",
                                        "Initial_Clock", "Final_Clock", "Subset_Start_Frame",
                                        "Subset_End_Frame", "Cyclic_Animation", "Quality",
-                                       "Work_Threads"};
+                                       "Work_Threads", "Library_Path"};
     const char *eq = strchr(a, '=');
     if ((a[0] == '+' || a[0] == '-') && a[1]) {
         const char c0 = (char)toupper((unsigned char)a[1]), c1 = (char)toupper((unsigned char)a[2]);
-        return c0 == 'K' || c0 == 'Q' || (c0 == 'W' && c1 == 'T') ||
+        return c0 == 'K' || c0 == 'Q' || c0 == 'L' || (c0 == 'W' && c1 == 'T') ||
                ((c0 == 'S' || c0 == 'E') && c1 == 'F');
     }
     for (size_t i = 0; eq && i < sizeof keys / sizeof keys[0]; i++)

@@ -20,8 +20,8 @@ void povargs_free(char **args);
 
 /* Whether the options leave POV-Ray nothing to do once it has written its pictures, so that
    it need not be waited for: each an animation or subset-of-frames option (+K..., +SF, +EF,
-   Initial_Frame=, ...), a quality or thread count (+Q, +WT) or a Declare=. Any other (an ini
-   named alone, a Post_Frame_Command=, ...) might. */
+   Initial_Frame=, ...), a quality or thread count (+Q, +WT), a library path (+L) or a
+   Declare=. Any other (an ini named alone, a Post_Frame_Command=, ...) might. */
 bool povargs_end_with_pictures(char *const *args, int count);
 
 /* The digits POV-Ray pads a frame number to: those of the final frame. */
