@@ -24,6 +24,10 @@ OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenIm
 # or write (`info` and `trace` never load it). The library calls back into the executable for
 # these four functions, so every executable that may load it exports them.
 IMAGE_IO_SO    = $(BUILD)/lens2pov-image-io.so
+# src/povray/povray_polls.c alone becomes lens2pov-povray-polls.so beside them, which the POV-Ray
+# processes lens2pov starts preload (src/povray/povray_env.c): never with the sanitizers, since
+# POV-Ray has no sanitizer runtime, and not in liblens2pov, whose programs keep their own waits.
+POLLS_SO       = $(BUILD)/lens2pov-povray-polls.so
 IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbol=cleanup_track \
                  -Wl,--export-dynamic-symbol=cleanup_untrack \
                  -Wl,--export-dynamic-symbol=outfile_create_temp
@@ -33,7 +37,7 @@ DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcr
                time
 
 # The sources, one folder per stage of the data flow (docs/source.md).
-LIB_C   = $(filter-out src/cli/main.c,$(wildcard src/*/*.c))
+LIB_C   = $(filter-out src/cli/main.c src/povray/povray_polls.c,$(wildcard src/*/*.c))
 LIB_OBJ = $(LIB_C:src/%.c=$(BUILD)/obj/%.o)
 TEST_C  = $(wildcard tests/*.c)
 TEST_OBJ = $(TEST_C:tests/%.c=$(BUILD)/tobj/%.o)
@@ -66,11 +70,14 @@ $(BUILD)/liblens2pov.a: $(LIB_OBJ)
 $(IMAGE_IO_SO): $(BUILD)/obj/image/image_io.o
 	$(CXX) $(SAN) -shared $^ -o $@ $(OIIO_LIBS)
 
-# Order-only: the library is loaded at run time, a new one needs no relink.
-$(BUILD)/lens2pov: $(BUILD)/obj/cli/main.o $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
+$(POLLS_SO): src/povray/povray_polls.c Makefile
+	$(CC) $(C_DIALECT) -O2 -Wall -Wextra -Werror -fPIC -shared $< -o $@ -ldl
+
+# Order-only: the libraries are loaded at run time, a new one needs no relink.
+$(BUILD)/lens2pov: $(BUILD)/obj/cli/main.o $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO) $(POLLS_SO)
 	$(CC) $(SAN) $(IMAGE_IO_HOST) $^ -o $@ $(LDLIBS)
 
-$(BUILD)/run_tests: $(TEST_OBJ) $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO)
+$(BUILD)/run_tests: $(TEST_OBJ) $(BUILD)/liblens2pov.a | $(IMAGE_IO_SO) $(POLLS_SO)
 	$(CC) $(SAN) $(IMAGE_IO_HOST) $^ -o $@ -lcriterion $(LDLIBS)
 
 $(BUILD)/tobj:
@@ -158,6 +165,7 @@ install: $(BUILD)/lens2pov
 	install -m 644 examples/README.md $(DESTDIR)$(PREFIX)/share/doc/lens2pov/examples
 	install -m 644 docs/*.md docs/*.png docs/*.svg $(DESTDIR)$(PREFIX)/share/doc/lens2pov/docs
 	install -m 644 $(IMAGE_IO_SO) $(DESTDIR)$(PREFIX)/lib/lens2pov/lens2pov-image-io.so
+	install -m 644 $(POLLS_SO) $(DESTDIR)$(PREFIX)/lib/lens2pov/lens2pov-povray-polls.so
 	install -m 644 lenses/*.dat $(DESTDIR)$(PREFIX)/share/lens2pov/lenses
 	install -m 644 pov/* $(DESTDIR)$(PREFIX)/share/lens2pov/pov
 

@@ -34,7 +34,8 @@ Test(install, installs_man_page_script_lenses_and_docs_that_work)
     static const char *const files[] = {
         "bin/lens2pov", "bin/lens2pov-render-all", "share/man/man1/lens2pov.1",
         "share/lens2pov/lenses/dgauss.50mm.dat", "share/doc/lens2pov/README.md",
-        "share/doc/lens2pov/docs/contracts.md", "lib/lens2pov/lens2pov-image-io.so"};
+        "share/doc/lens2pov/docs/contracts.md", "lib/lens2pov/lens2pov-image-io.so",
+        "lib/lens2pov/lens2pov-povray-polls.so"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
         cr_expect_eq(access(tmp_path(p, files[i]), R_OK), 0, "%s not installed", files[i]);
 

@@ -64,7 +64,7 @@ static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *ol
     if (chdir(r->scene_real_dir) != 0) {
         write_text(STDERR_FILENO, "lens2pov: cannot enter the scene's folder ", r->scene_real_dir);
     } else {
-        execv(argv[0], argv);
+        execve(argv[0], argv, r->env);
         write_text(STDERR_FILENO, "lens2pov: cannot run ", argv[0]);
     }
     _exit(127);

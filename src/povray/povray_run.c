@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "povray/povray_cmd.h"
+#include "povray/povray_env.h"
 #include "raytable/chunk_name.h"
 
 int povray_out_of_memory(l2p_error *err)
@@ -19,6 +20,7 @@ int povray_out_of_memory(l2p_error *err)
 void povray_run_free(run *r)
 {
     free(r->exe);
+    povray_environment_free(r->env);
     free(r->work_dir);
     free(r->chunk_prefix);
     free(r->scene_real_dir);
@@ -166,6 +168,8 @@ int povray_run_prepare(run *r, const povray_chunk *chunks, int count, const int 
         st = prepare_scene(r, err);
     if (!st)
         st = find_povray(r, err);
+    if (!st && !(r->env = povray_environment()))
+        st = povray_out_of_memory(err);
     return st;
 }
 

@@ -29,6 +29,7 @@ typedef struct run {
     int tasks;
     const povray_options *opts;
     char *exe;
+    char **env;                /* POV-Ray's environment (povray_env.h) */
     char *work_dir;
     char *chunk_prefix;        /* WORK/povray: the wrappers and logs are its chunk files */
     char *scene_real_dir;      /* the child's working folder */

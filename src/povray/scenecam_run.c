@@ -21,7 +21,10 @@
 #include "base/outfile.h"
 #include "base/tempdir.h"
 #include "povray/povargs.h"
+#include "povray/povray_env.h"
 #include "povray/povray_log.h"
+
+extern char **environ;
 
 /* The whole file, NUL-terminated (malloc'd); *n its length. */
 static char *read_all(const char *path, size_t *n)
@@ -198,9 +201,15 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
         argv[n++] = pa->user[i];
     for (int i = 0; i < OWN; i++)
         argv[n++] = own[i];
+    char **env = povray_environment();
+    if (!env) {
+        free(argv);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
     const int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) {
         free(argv);
+        povray_environment_free(env);
         return l2p_fail(err, L2P_FAILED, log, 0, "cannot write: %s", strerror(errno));
     }
     sigset_t old;
@@ -217,6 +226,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
             dup2(null_fd, STDIN_FILENO);
         dup2(fd, STDOUT_FILENO);
         dup2(fd, STDERR_FILENO);
+        environ = env;   /* execvp searches PATH and passes environ */
         if (chdir(dir) == 0)
             execvp(exe, argv);
         _exit(127);
@@ -226,6 +236,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     close(fd);
     free(argv);
+    povray_environment_free(env);
     if (pid < 0)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "cannot start POV-Ray: %s", strerror(errno));
     const int status = wait_probe(pid, log, povargs_end_with_pictures(pa->user, pa->user_count));
