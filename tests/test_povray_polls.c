@@ -187,7 +187,7 @@ static float *frame(const char *dir, const char *name, int *w, int *h)
     return px;
 }
 
-Test(povray_polls, pictures_are_the_same_with_the_library_and_without, .timeout = 120)
+Test(povray_polls, pictures_are_the_same_with_the_library_and_without)
 {
     const char *dir = test_tmpdir();
     char scene[600], script[600], text[1600];
