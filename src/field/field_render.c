@@ -3,6 +3,7 @@
    faces, each render's include and ini (field_povray.c runs and develops them). */
 #include "field/field_files.h"
 
+#include <limits.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -14,6 +15,7 @@
 #include "raytable/chunk_ini.h"
 #include "optics/pupil.h"
 #include "povray/povray.h"
+#include "povray/povray_env.h"
 #include "raytable/povmesh.h"
 
 typedef struct sub {
@@ -116,18 +118,23 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
     *rh = field_render_size((n + nx - 1) / nx * h);
 }
 
-/* Faces a render takes. Each render is a frame of a POV-Ray run, about FRAME_S of overhead;
-   POV-Ray's face search costs a pixel about SEARCH_S a face of its render (it scans the faces
-   in order up to the first that holds the pixel; docs/povray.md). Renders of B faces, of
-   sub-images of f faces and p pixels each, cost (spp f / B) FRAME_S + spp p SEARCH_S B, least
-   at B = sqrt(FRAME_S f / (p SEARCH_S)); at most FIELD_FACES_PER_RENDER. */
+/* Faces a render takes. Each render is a frame of a POV-Ray run, with an overhead of about
+   FRAME_S, or FRAME_POLLS_S where POV-Ray's polls are shortened (povray_env.h); POV-Ray's face
+   search costs a pixel about SEARCH_S a face of its render (it scans the faces in order up to
+   the first that holds the pixel; docs/povray.md). Renders of B faces, of sub-images of f
+   faces and p pixels each, cost (spp f / B) frame + spp p SEARCH_S B, least at
+   B = sqrt(frame f / (p SEARCH_S)); at most FIELD_FACES_PER_RENDER. FRAME_POLLS_S is the
+   value that rendered fastest (docs/benchmarks.md, "session 11"). */
 #define FRAME_S 0.25
+#define FRAME_POLLS_S 0.04
 #define SEARCH_S 4e-11
 
 static long long face_budget(long long faces, int spp, int w, int h)
 {
+    char library[PATH_MAX + 64];
+    const double frame = povray_polls_library(library, sizeof library) ? FRAME_POLLS_S : FRAME_S;
     const double f = fmax(1.0, (double)faces / spp);
-    const double b = sqrt(FRAME_S * f / ((double)w * h * SEARCH_S));
+    const double b = sqrt(frame * f / ((double)w * h * SEARCH_S));
     return (long long)fmax(1.0, fmin(b, FIELD_FACES_PER_RENDER));
 }
 
