@@ -71,6 +71,7 @@ $(IMAGE_IO_SO): $(BUILD)/obj/image/image_io.o
 	$(CXX) $(SAN) -shared $^ -o $@ $(OIIO_LIBS)
 
 $(POLLS_SO): src/povray/povray_polls.c Makefile
+	@mkdir -p $(@D)
 	$(CC) $(C_DIALECT) -O2 -Wall -Wextra -Werror -fPIC -shared $< -o $@ -ldl
 
 # Order-only: the libraries are loaded at run time, a new one needs no relink.

@@ -38,7 +38,15 @@ typedef struct field_files_request {
        placement, declared by the wrapper); NULL: none. */
     const char *placement;
     outfile *rays_csv;         /* --rays: written and finished, not committed; NULL: none */
+    /* What a render costs POV-Ray beyond its pixels, as a frame of a run (seconds): what the
+       packing weighs against the face search (field_render.c, face_budget). */
+    double frame_s;
 } field_files_request;
+
+/* That cost as POV-Ray is, and as lens2pov runs it, its polls shortened (povray_env.h): the
+   value that rendered fastest (docs/benchmarks.md, "session 11"). */
+#define FIELD_FRAME_S 0.25
+#define FIELD_FRAME_POLLS_S 0.04
 
 /* Builds the sub-images and writes the map, every render's include and ini and the CSV, then
    commits all but the CSV. L2P_BAD_INPUT naming --sampling pixel for a tolerance not above 0

@@ -5,6 +5,7 @@
    sampling runs its chunks. */
 #include "field/field_render.h"
 
+#include <limits.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +15,7 @@
 #include "image/image_io.h"
 #include "povray/povargs.h"
 #include "povray/povray.h"
+#include "povray/povray_env.h"
 
 /* A POV-Ray process renders its job's renders as the frames of one animation
    (povray_render_sequences), paying POV-Ray's start-up and exit once a job, not once a
@@ -157,9 +159,12 @@ static int develop_frames(const field_files *f, const povray_chunk *pc,
 
 int field_render(const camera *c, const field_render_options *o, l2p_error *err)
 {
+    char library[PATH_MAX + 64];
     const field_files_request q = {o->prefix, o->jobs, o->tolerance_px,
                                    o->frames[0].placement ? "Lens2pov_Placement" : NULL,
-                                   o->rays_csv};
+                                   o->rays_csv,
+                                   povray_polls_library(library, sizeof library)
+                                       ? FIELD_FRAME_POLLS_S : FIELD_FRAME_S};
     field_files f;
     int st = field_files_make(c, &q, &f, err);
     if (o->too_fine)

@@ -3,7 +3,6 @@
    faces, each render's include and ini (field_povray.c runs and develops them). */
 #include "field/field_files.h"
 
-#include <limits.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -15,7 +14,6 @@
 #include "raytable/chunk_ini.h"
 #include "optics/pupil.h"
 #include "povray/povray.h"
-#include "povray/povray_env.h"
 #include "raytable/povmesh.h"
 
 typedef struct sub {
@@ -119,22 +117,16 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
 }
 
 /* Faces a render takes. Each render is a frame of a POV-Ray run, with an overhead of about
-   FRAME_S, or FRAME_POLLS_S where POV-Ray's polls are shortened (povray_env.h); POV-Ray's face
-   search costs a pixel about SEARCH_S a face of its render (it scans the faces in order up to
-   the first that holds the pixel; docs/povray.md). Renders of B faces, of sub-images of f
-   faces and p pixels each, cost (spp f / B) frame + spp p SEARCH_S B, least at
-   B = sqrt(frame f / (p SEARCH_S)); at most FIELD_FACES_PER_RENDER. FRAME_POLLS_S is the
-   value that rendered fastest (docs/benchmarks.md, "session 11"). */
-#define FRAME_S 0.25
-#define FRAME_POLLS_S 0.04
+   frame_s; POV-Ray's face search costs a pixel about SEARCH_S a face of its render (it scans
+   the faces in order up to the first that holds the pixel; docs/povray.md). Renders of B faces,
+   of sub-images of f faces and p pixels each, cost (spp f / B) frame_s + spp p SEARCH_S B,
+   least at B = sqrt(frame_s f / (p SEARCH_S)); at most FIELD_FACES_PER_RENDER. */
 #define SEARCH_S 4e-11
 
-static long long face_budget(long long faces, int spp, int w, int h)
+static long long face_budget(long long faces, int spp, int w, int h, double frame_s)
 {
-    char library[PATH_MAX + 64];
-    const double frame = povray_polls_library(library, sizeof library) ? FRAME_POLLS_S : FRAME_S;
     const double f = fmax(1.0, (double)faces / spp);
-    const double b = sqrt(frame * f / ((double)w * h * SEARCH_S));
+    const double b = sqrt(frame_s * f / ((double)w * h * SEARCH_S));
     return (long long)fmax(1.0, fmin(b, FIELD_FACES_PER_RENDER));
 }
 
@@ -170,9 +162,10 @@ static int grid_of(int n, int w, int h)
    equal share for every job take (of the first sub-images) and that has a grid; at least as
    many as the budget needs on average; a multiple of the jobs, so that the jobs get equal
    shares. */
-static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long all)
+static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long all,
+                        double frame_s)
 {
-    const long long budget = face_budget(all, spp, w, h);
+    const long long budget = face_budget(all, spp, w, h, frame_s);
     const int most = (spp + jobs - 1) / jobs;
     long long faces = 0;
     int count = 1;
@@ -194,12 +187,13 @@ static int render_count(const sub *subs, int spp, int w, int h, int jobs, long l
    with one grid and size since a POV-Ray process renders all its renders at one size
    (assign_jobs); a render holds at most FIELD_FACES_PER_RENDER faces, or one sub-image (more
    renders then follow). Returns the number of renders. */
-static int pack(sub *subs, int spp, int w, int h, int jobs, field_render_plan *plans)
+static int pack(sub *subs, int spp, int w, int h, int jobs, double frame_s,
+                field_render_plan *plans)
 {
     long long all = 0;
     for (int k = 0; k < spp; k++)
         all += subs[k].stats.faces;
-    const int even = render_count(subs, spp, w, h, jobs, all);
+    const int even = render_count(subs, spp, w, h, jobs, all, frame_s);
     const int grid_n = (spp + even - 1) / even;
     int grid_nx = grid_of(grid_n, w, h);
     if (!grid_nx)   /* fewer than a count that has a grid: the shortest row */
@@ -382,7 +376,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
         st = build_all(&j, jobs, err);
     out->too_fine = st && j.too_fine;
     pthread_mutex_destroy(&j.lock);
-    const int renders = st ? 0 : pack(subs, spp, w, h, jobs, plans);
+    const int renders = st ? 0 : pack(subs, spp, w, h, jobs, q->frame_s, plans);
     if (!st)
         st = finish_map(c, subs, plans, renders, &out->map, err);
     if (!st)
@@ -437,7 +431,9 @@ int field_files_make(const camera *c, const field_files_request *q, field_files 
 int field_trace(const camera *c, const field_trace_options *o, field_trace_stats *stats,
                 l2p_error *err)
 {
-    const field_files_request q = {o->prefix, o->jobs, o->tolerance_px, NULL, o->rays_csv};
+    /* the renders are for the user's POV-Ray, whose polls are as they are */
+    const field_files_request q = {o->prefix, o->jobs, o->tolerance_px, NULL, o->rays_csv,
+                                   FIELD_FRAME_S};
     field_files f;
     const int st = field_files_make(c, &q, &f, err);
     *stats = f.stats;

@@ -43,7 +43,7 @@ static void write_text(int fd, const char *a, const char *b)
 
 /* In the child: default signal handling (ours would remove the run's files), SIGTERM when
    lens2pov dies however it dies (SIGKILL, the out-of-memory killer: the parent-death signal
-   outlives execv; lens2pov forks from its main thread, whose end is the process's), stdin from
+   outlives execve; lens2pov forks from its main thread, whose end is the process's), stdin from
    /dev/null, stdout and stderr into the log, the scene's folder as working folder. Only
    async-signal-safe calls: the parent may have threads. */
 static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *old_mask,

@@ -3,7 +3,8 @@
    100 ms, so a run idles about half a second before its first frame and about a quarter of a
    second between frames. Here every such wait of at most LONGEST_POLL_NS ends after POLL_NS
    instead, as if its time had run out; longer waits are left as they are (POV-Ray crashed at
-   start-up when those were cut short too). What POV-Ray computes does not change, only how
+   start-up when those were cut short too), except that a long wait on a condition variable
+   resumed within 200 ms of its deadline counts as a poll. What POV-Ray computes does not change, only how
    soon its threads look again (docs/povray.md, "Polls"). A shorter POLL_NS costs POV-Ray CPU
    time that a render which keeps both cores busy misses.
 
@@ -17,6 +18,7 @@
 #include <pthread.h>
 #include <stdbool.h>
 #include <stdlib.h>
+#include <sys/syscall.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -24,49 +26,60 @@ static const long long POLL_NS = 5000000;           /* what a poll is shortened 
 static const long long LONGEST_POLL_NS = 200000000; /* POV-Ray polls every 10, 50 or 100 ms */
 static const long long NS = 1000000000;
 
-static bool active;
-static int (*real_nanosleep)(const struct timespec *, struct timespec *);
-static int (*real_clock_nanosleep)(clockid_t, int, const struct timespec *, struct timespec *);
-static int (*real_cond_timedwait)(pthread_cond_t *, pthread_mutex_t *, const struct timespec *);
+typedef int cond_timedwait_fn(pthread_cond_t *, pthread_mutex_t *, const struct timespec *);
+
+static bool active;   /* set by start(), which may run after other libraries' constructors */
 
 /* Exported so that a test can see whether the library acts in a process. */
 bool lens2pov_polls_active(void) { return active; }
 
 __attribute__((constructor)) static void start(void)
 {
-    real_nanosleep = (int (*)(const struct timespec *, struct timespec *))dlsym(RTLD_NEXT, "nanosleep");
-    real_clock_nanosleep = (int (*)(clockid_t, int, const struct timespec *, struct timespec *))
-        dlsym(RTLD_NEXT, "clock_nanosleep");
-    real_cond_timedwait = (int (*)(pthread_cond_t *, pthread_mutex_t *, const struct timespec *))
-        dlvsym(RTLD_NEXT, "pthread_cond_timedwait", "GLIBC_2.3.2");
     const char *parent = getenv("LENS2POV_POLLS_PARENT");
-    active = parent && *parent && atoll(parent) == (long long)getppid() && real_nanosleep &&
-             real_clock_nanosleep && real_cond_timedwait;
+    active = parent && *parent && atoll(parent) == (long long)getppid();
 }
 
-static long long ns_of(const struct timespec *t) { return t->tv_sec * NS + t->tv_nsec; }
-static struct timespec timespec_of(long long ns) { return (struct timespec){ns / NS, ns % NS}; }
+/* The next definition of a function, looked up on first use. pthread_cond_timedwait has two
+   versions on x86-64 (the old one for programs of 2002 and before); the newer is the one
+   programs link to, and on other architectures the only one, under another version name. */
+static cond_timedwait_fn *real_cond_timedwait(void)
+{
+    static cond_timedwait_fn *f;
+    if (!f) {
+        void *p = dlvsym(RTLD_NEXT, "pthread_cond_timedwait", "GLIBC_2.3.2");
+        f = (cond_timedwait_fn *)(p ? p : dlsym(RTLD_NEXT, "pthread_cond_timedwait"));
+    }
+    return f;
+}
+
+/* A relative wait's length, or -1 when it is not a valid one. */
+static long long length_ns(const struct timespec *t)
+{
+    if (t->tv_nsec < 0 || t->tv_nsec >= NS || t->tv_sec < 0 || t->tv_sec > 1)
+        return -1;
+    return t->tv_sec * NS + t->tv_nsec;
+}
 
 static bool is_poll(long long ns) { return active && ns > POLL_NS && ns <= LONGEST_POLL_NS; }
 
+/* The sleeps go straight to the kernel: no lookup can fail, even before start(). */
 int nanosleep(const struct timespec *req, struct timespec *rem)
 {
-    if (!real_nanosleep)
-        return errno = ENOSYS, -1;
-    if (!req || !is_poll(ns_of(req)))
-        return real_nanosleep(req, rem);
-    const struct timespec poll = timespec_of(POLL_NS);
-    return real_nanosleep(&poll, rem);
+    const struct timespec poll = {0, POLL_NS};
+    return (int)syscall(SYS_nanosleep, req && is_poll(length_ns(req)) ? &poll : req, rem);
 }
 
 int clock_nanosleep(clockid_t clock, int flags, const struct timespec *req, struct timespec *rem)
 {
-    if (!real_clock_nanosleep)
-        return ENOSYS;
-    if (!req || (flags & TIMER_ABSTIME) || !is_poll(ns_of(req)))
-        return real_clock_nanosleep(clock, flags, req, rem);
-    const struct timespec poll = timespec_of(POLL_NS);
-    return real_clock_nanosleep(clock, flags, &poll, rem);
+    const struct timespec poll = {0, POLL_NS};
+    if (req && !(flags & TIMER_ABSTIME) && is_poll(length_ns(req)))
+        req = &poll;
+    /* the system call returns -1 and sets errno; clock_nanosleep returns the error */
+    const int saved = errno;
+    const long r = syscall(SYS_clock_nanosleep, clock, flags, req, rem);
+    const int e = r == 0 ? 0 : errno;
+    errno = saved;
+    return e;
 }
 
 /* The deadline is absolute on the clock the condition variable was made with, which cannot be
@@ -76,18 +89,24 @@ int clock_nanosleep(clockid_t clock, int flags, const struct timespec *req, stru
 int pthread_cond_timedwait(pthread_cond_t *cond, pthread_mutex_t *mutex,
                            const struct timespec *deadline)
 {
-    if (!real_cond_timedwait)
+    cond_timedwait_fn *wait = real_cond_timedwait();
+    if (!wait)
         return ENOSYS;
-    if (active) {
+    if (active && deadline->tv_nsec >= 0 && deadline->tv_nsec < NS) {
         const clockid_t clocks[2] = {CLOCK_MONOTONIC, CLOCK_REALTIME};
         for (int i = 0; i < 2; i++) {
             struct timespec now;
             clock_gettime(clocks[i], &now);
-            if (is_poll(ns_of(deadline) - ns_of(&now))) {
-                const struct timespec sooner = timespec_of(ns_of(&now) + POLL_NS);
-                return real_cond_timedwait(cond, mutex, &sooner);
+            if (deadline->tv_sec < now.tv_sec || deadline->tv_sec - now.tv_sec > 1)
+                continue;
+            const long long left = (deadline->tv_sec - now.tv_sec) * NS +
+                                   (deadline->tv_nsec - now.tv_nsec);
+            if (is_poll(left)) {
+                const long long t = now.tv_nsec + POLL_NS;
+                const struct timespec sooner = {now.tv_sec + t / NS, t % NS};
+                return wait(cond, mutex, &sooner);
             }
         }
     }
-    return real_cond_timedwait(cond, mutex, deadline);
+    return wait(cond, mutex, deadline);
 }

@@ -89,7 +89,7 @@ static bool is_executable_file(const char *path)
     return stat(path, &st) == 0 && S_ISREG(st.st_mode) && access(path, X_OK) == 0;
 }
 
-/* The executable's absolute path (the child changes folder before execv). */
+/* The executable's absolute path (the child changes folder before execve). */
 static int find_povray(run *r, l2p_error *err)
 {
     const char *name = r->opts->povray;

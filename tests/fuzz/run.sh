@@ -22,7 +22,7 @@ san=${FUZZ_SANITIZERS:?"run it as make fuzz, which gives the flags"}
 cflags="${FUZZ_CFLAGS:?"run it as make fuzz, which gives the flags"} -I$root/src"
 
 mkdir -p "$out/obj"
-# Every C source but main.c and the preload library POV-Ray gets (povray_polls.c), instrumented for coverage (fuzzer-no-link), into an archive: the
+# Every C source but main.c and povray_polls.c (a library POV-Ray preloads), instrumented for coverage (fuzzer-no-link), into an archive: the
 # link then takes only the objects a target needs (no OpenImageIO, no POV-Ray runner).
 objs=
 for src in "$root"/src/*/*.c; do
