@@ -51,7 +51,9 @@ char **povray_environment(void)
     size_t n = 0;
     bool ok = true;
     for (size_t i = 0; i < count && ok; i++) {
-        if (preload && (named(environ[i], "LD_PRELOAD") || named(environ[i], "LENS2POV_POLLS_PARENT")))
+        const bool replaced = named(environ[i], "LD_PRELOAD") ||
+                              named(environ[i], "LENS2POV_POLLS_PARENT");
+        if (preload && replaced)
             continue;
         ok = (env[n++] = strdup(environ[i])) != NULL;
     }

@@ -1,12 +1,12 @@
 /* lens2pov-povray-polls.so, preloaded (LD_PRELOAD) into the POV-Ray processes lens2pov starts:
    POV-Ray 3.7's threads hand work to each other by polling, each poll a timed wait of 10 to
-   100 ms, so a run idles about half a second before its first frame and about a quarter of a
-   second between frames. Here every such wait of at most LONGEST_POLL_NS ends after POLL_NS
-   instead, as if its time had run out; longer waits are left as they are (POV-Ray crashed at
-   start-up when those were cut short too), except that a long wait on a condition variable
-   resumed within 200 ms of its deadline counts as a poll. What POV-Ray computes does not change, only how
-   soon its threads look again (docs/povray.md, "Polls"). A shorter POLL_NS costs POV-Ray CPU
-   time that a render which keeps both cores busy misses.
+   100 ms, so a run idles about 0.2 s before its first frame and about a quarter of a second
+   between frames. Here every such wait of at most LONGEST_POLL_NS ends after POLL_NS instead,
+   as if its time had run out. Longer waits are left as they are (POV-Ray crashed at start-up
+   when those were cut short too), except that a long wait on a condition variable resumed
+   within LONGEST_POLL_NS of its deadline counts as a poll. What POV-Ray computes does not
+   change, only how soon its threads look again (docs/povray.md, "Polls"). A shorter POLL_NS
+   costs POV-Ray CPU time that a render which keeps both cores busy misses.
 
    The library is built without the sanitizers (POV-Ray has no sanitizer runtime) and is not
    part of liblens2pov. It acts only in the process lens2pov started itself: the one whose
