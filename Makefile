@@ -95,8 +95,9 @@ test: deps
 	$(MAKE) test-sanitize
 	$(MAKE) test-extra
 
-# Checks beyond the Criterion suite: a short fuzz run of the lens reader and the option parser,
-# and valgrind over info, trace, a bad lens, develop and a render (tools/valgrind.sh).
+# Checks beyond the Criterion suite: a short fuzz run of the lens reader, the option parser and
+# the scene-camera reader, and valgrind over info, trace, a bad lens, develop and a render
+# (tools/valgrind.sh).
 test-extra: fuzz valgrind
 
 # The same suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its own build folder.

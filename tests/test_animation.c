@@ -230,7 +230,9 @@ Test(animation, frames_from_log)
                       "lens2pov-location 2 1 -4|\nlens2pov-end|\n";
     scene_frames f;
     l2p_error err;
-    cr_assert_eq(scene_frames_from_log(log, strlen(log), "s.pov", &f, &err), 0, "%s", err.text);
+    const char *scene = "s.pov";
+    const scene_files files = {&scene, 1};
+    cr_assert_eq(scene_frames_from_log(log, strlen(log), &files, &f, &err), 0, "%s", err.text);
     cr_assert_eq(f.count, 2);
     cr_expect(f.animated && f.final_frame == 3);
     cr_expect(f.frame[0].number == 1 && f.frame[1].number == 2 && f.frame[1].clock == 0.5);

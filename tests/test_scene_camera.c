@@ -43,10 +43,10 @@ static void povray_render(const char *dir, const char *scene, const char *out)
     cr_assert_eq(system_povray(cmd), 0, "%s", cmd);
 }
 
-/* The scene through the lens, with no placement and --angle scene, against POV-Ray's camera. */
-static void expect_markers_as_povray(const char *scene_text)
+/* The scene, in dir, through the lens, with no placement and --angle scene, against POV-Ray's
+   camera. */
+static void expect_markers_in(const char *dir, const char *scene_text)
 {
-    const char *dir = test_tmpdir();
     char scene[512], own[512], lens[512];
     snprintf(scene, sizeof scene, "%s/scene.pov", dir);
     snprintf(own, sizeof own, "%s/own.png", dir);
@@ -66,6 +66,11 @@ static void expect_markers_as_povray(const char *scene_text)
         cr_expect(fabs(a.x - b.x) < 1.0 && fabs(a.y - b.y) < 1.0,
                   "marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", c, a.x, a.y, b.x, b.y);
     }
+}
+
+static void expect_markers_as_povray(const char *scene_text)
+{
+    expect_markers_in(test_tmpdir(), scene_text);
 }
 
 Test(scene_camera, declared_vectors_expression_and_angle)
@@ -89,14 +94,6 @@ Test(scene_camera, transforms_and_the_last_camera)
                              "  rotate <0, 5, 0> translate Target }\n");
 }
 
-static int count_newlines(const char *s)
-{
-    int n = 0;
-    for (; *s; s++)
-        n += *s == '\n';
-    return n;
-}
-
 Test(scene_camera, orthographic_is_refused)
 {
     const char *dir = test_tmpdir();
@@ -114,30 +111,98 @@ Test(scene_camera, orthographic_is_refused)
     free(errtext);
 }
 
-/* A camera in a file the scene includes from its folder, nested two deep: the probe reads
-   only the scene's text, so it is refused naming the scene's #include line and the camera's
-   file and line; with explicit placement the scene renders. Comments and strings that look
-   like a camera or an #include do not count. */
-Test(scene_camera, a_camera_in_an_included_file_is_refused)
+/* Conditionals, #debug and #warning inside the camera block are followed as POV-Ray follows
+   them (focal blur switched by a quality setting is a common use). */
+Test(scene_camera, conditionals_inside_the_camera_block)
+{
+    expect_markers_as_povray(MARKERS_HEAD
+                             "#declare Quality = 2;\n"
+                             "camera {\n  location <5, 5, 5>\n"
+                             "#if (image_width > 10) location Lift(Eye) #else location 9 #end\n"
+                             "  look_at Target\n#ifdef (Undeclared) angle 80 #end\n"
+                             "#switch (Quality)\n#case (1) angle 80 #break\n"
+                             "#range (2, 3) angle 40 aperture 0.1 #debug \"fine\\n\" #break\n"
+                             "#end #warning \"kept\"\n"
+                             "  right x * image_width / image_height\n}\n");
+}
+
+/* Any other directive inside the block, or a word that is no camera item, is refused naming
+   the statement's line (exit 2); a word in a branch that does not run is not read, as POV-Ray
+   does not read it. */
+Test(scene_camera, other_directives_and_unknown_words_are_refused)
 {
     const char *dir = test_tmpdir();
-    char scene[512], outer[512], inner[512], out[512];
-    snprintf(scene, sizeof scene, "%s/inc.pov", dir);
+    static const struct {
+        const char *camera, *why;
+        int status;
+    } cases[] = {
+        {"camera { location <0, 1, -4>\n  #declare A = 1; look_at 0 }\n", "#warning", 2},
+        {"camera { location <0, 1, -4>\n  #if (1) bogus 3 #end look_at 0 }\n", "not a camera", 2},
+        {"camera { location <0, 1, -4>\n  #if (0) bogus 3 #end look_at 0 }\n", NULL, 0},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        char scene[512], out[512], where[600];
+        snprintf(scene, sizeof scene, "%s/d%zu.pov", dir, k);
+        snprintf(out, sizeof out, "%s/d%zu.png", dir, k);
+        write_text(scene, cases[k].camera);
+        char *errtext = NULL;
+        const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q",
+                           "-o", out);
+        snprintf(where, sizeof where, "lens2pov: %s:1: ", scene);
+        cr_expect_eq(st, cases[k].status, "case %zu: %s", k, errtext ? errtext : "");
+        if (cases[k].why)
+            cr_expect(errtext && !strncmp(errtext, where, strlen(where)) &&
+                          strstr(errtext, cases[k].why),
+                      "case %zu: expected '%s' and '%s' in: %s", k, where, cases[k].why,
+                      errtext ? errtext : "");
+        free(errtext);
+    }
+}
+
+/* A camera in a file the scene includes from its folder, nested two deep, after a camera of
+   the scene's own: it is the last to run, so it is the camera, its expressions evaluated
+   where its file stands. A standard include is not copied; comments that look like a camera
+   or an #include do not count. */
+Test(scene_camera, a_camera_in_an_included_file_is_the_camera)
+{
+    const char *dir = test_tmpdir();
+    char outer[512], inner[512];
     snprintf(outer, sizeof outer, "%s/outer.inc", dir);
     snprintf(inner, sizeof inner, "%s/inner.inc", dir);
-    snprintf(out, sizeof out, "%s/out.png", dir);
-    write_text(inner, "// camera { location 0 }\n\ncamera { location <0, 1, -4> look_at 0 }\n");
+    write_text(inner, "// camera { location 0 }\n\n" CAMERA("x"));
     write_text(outer, "/* #include \"nothing.inc\" */\n#include \"inner.inc\"\n");
-    write_text(scene, MARKERS_HEAD "#include \"colors.inc\"\n#include \"outer.inc\"\n");
-    char *errtext = NULL;
+    expect_markers_in(dir, MARKERS_HEAD "camera { location <5, 5, 5> look_at 0 angle 80 }\n"
+                           "#include \"colors.inc\"\n#include \"outer.inc\"\n");
+}
+
+/* What is wrong with a camera in an included file is reported in that file's name and line:
+   a camera lens2pov cannot stand in for (exit 2), and POV-Ray's own error. Nothing is
+   written; with explicit placement the first scene renders. */
+Test(scene_camera, an_included_cameras_faults_name_its_file)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], broken[512], inc[512], bad[512], out[512];
+    snprintf(scene, sizeof scene, "%s/inc.pov", dir);
+    snprintf(broken, sizeof broken, "%s/broken.pov", dir);
+    snprintf(inc, sizeof inc, "%s/ortho.inc", dir);
+    snprintf(bad, sizeof bad, "%s/bad.inc", dir);
+    snprintf(out, sizeof out, "%s/out.png", dir);
+    write_text(inc, "\n\ncamera { orthographic location <0, 1, -4> look_at 0 }\n");
+    write_text(bad, "\ncamera { location <0, 1, -4> look_at Undeclared }\n");
+    write_text(scene, MARKERS_HEAD "#include \"ortho.inc\"\n");
+    write_text(broken, MARKERS_HEAD "#include \"bad.inc\"\n");
+    char *errtext = NULL, where[600];
     int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
+    snprintf(where, sizeof where, "lens2pov: %s:3: ", inc);
     cr_expect_eq(st, 2, "%s", errtext ? errtext : "");
-    char where[600], what[600];
-    const int scene_line = count_newlines(MARKERS_HEAD) + 2;   /* #include "outer.inc" */
-    snprintf(where, sizeof where, "lens2pov: %s:%d: ", scene, scene_line);
-    snprintf(what, sizeof what, "%s (line 3)", inner);
-    cr_expect(errtext && !strncmp(errtext, where, strlen(where)) && strstr(errtext, what),
-              "expected '%s' and '%s' in: %s", where, what, errtext ? errtext : "");
+    cr_expect(errtext && !strncmp(errtext, where, strlen(where)) && strstr(errtext, "orthographic"),
+              "expected '%s' in: %s", where, errtext ? errtext : "");
+    free(errtext);
+    st = L2P(NULL, &errtext, "render", broken, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
+    snprintf(where, sizeof where, "lens2pov: %s:2: ", bad);
+    cr_expect_neq(st, 0);
+    cr_expect(errtext && !strncmp(errtext, where, strlen(where)) && strstr(errtext, "Undeclared"),
+              "expected '%s' in: %s", where, errtext ? errtext : "");
     free(errtext);
     struct stat sb;
     cr_expect(stat(out, &sb) != 0, "an output was written");
@@ -215,7 +280,9 @@ Test(scene_camera, wrapped_messages)
                       "\nlens2pov-end|\n";
     scene_camera sc;
     l2p_error err;
-    cr_assert_eq(scene_camera_from_log(log, strlen(log), "s.pov", &sc, &err), 0, "%s", err.text);
+    const char *scene = "s.pov";
+    const scene_files files = {&scene, 1};
+    cr_assert_eq(scene_camera_from_log(log, strlen(log), &files, &sc, &err), 0, "%s", err.text);
     cr_expect(sc.found && sc.line == 7);
     cr_expect(fabs(sc.location.y - 2.0) < 1e-15 && fabs(sc.location.z + 3.0) < 1e-15);
     cr_expect(fabs(sc.forward.z - 1.0) < 1e-15 && fabs(sc.focus_distance - 3.0) < 1e-12);

@@ -103,11 +103,7 @@ int render_frames_plan(const cli *c, render_frames *out, l2p_error *err)
         return framing_from_scene(&f->table_cli, c->positional[0], err);
     }
     scene_frames sf;
-    int st = c->placed && !c->angle_scene ? L2P_OK
-                                          : scene_camera_check_includes(c->positional[0], err);
-    if (st)
-        return st;
-    st = scene_frames_read(c->positional[0], c->cam.width, c->cam.height, c->povray_args,
+    int st = scene_frames_read(c->positional[0], c->cam.width, c->cam.height, c->povray_args,
                                c->povray_arg_count, &sf, err);
     if (st)
         return st;

@@ -12,9 +12,7 @@ int framing_from_scene(cli *c, const char *scene, l2p_error *err)
     if (c->placed && !c->angle_scene)
         return L2P_OK;
     scene_camera sc;
-    int st = scene_camera_check_includes(scene, err);
-    if (!st)
-        st = scene_camera_read(scene, c->cam.width, c->cam.height, &sc, err);
+    const int st = scene_camera_read(scene, c->cam.width, c->cam.height, &sc, err);
     if (!st)
         framing_apply(c, &sc);
     return st;

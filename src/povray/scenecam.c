@@ -41,7 +41,7 @@ typedef struct pov_camera {
     char type[32];
     vec3 location, direction, up, right, sky, look_at, focus;
     double angle;
-    bool has_look_at, has_angle, declared, unsupported;
+    bool has_look_at, has_angle, declared, unsupported, directive;
     affine trans, pending;     /* the transforms so far; the one being read */
     double version;
 } pov_camera;
@@ -151,7 +151,9 @@ static bool take_item(pov_camera *c, const char *msg, const char *scene, int lin
         return sscanf(rest, "%31s", c->type) == 1;
     if (!strcmp(word, "declared"))
         return c->declared = true;
-    if (!strcmp(word, "directive") || !strcmp(word, "unknown"))
+    if (!strcmp(word, "directive"))
+        return c->unsupported = c->directive = true;
+    if (!strcmp(word, "unknown"))
         return c->unsupported = true;
     if (!strcmp(word, "angle")) {
         if (!read_numbers(rest, &c->angle, 1))
@@ -231,8 +233,13 @@ static int to_scene_camera(const pov_camera *c, const char *scene, int line, sce
     char why[128];
     if (c->declared)
         return refuse(err, scene, line, "the camera starts from a declared camera");
+    if (c->directive)
+        return refuse(err, scene, line, "the camera block holds a directive other than #if, "
+                      "#ifdef, #ifndef, #elseif, #else, #switch, #case, #range, #break, #end, "
+                      "#debug and #warning");
     if (c->unsupported)
-        return refuse(err, scene, line, "the camera block holds a directive or an unknown word");
+        return refuse(err, scene, line,
+                      "the camera block holds a word that is not a camera item");
     if (strcmp(c->type, "perspective")) {
         snprintf(why, sizeof why, "the camera is %s, not perspective", c->type);
         return refuse(err, scene, line, why);
@@ -259,8 +266,18 @@ static int to_scene_camera(const pov_camera *c, const char *scene, int line, sce
     return L2P_OK;
 }
 
-int scene_camera_from_log(const char *log, size_t n, const char *scene, scene_camera *out,
-                          l2p_error *err)
+/* The file a camera message names: its number after the line (none: the scene). */
+static const char *file_of(const char *msg, const scene_files *files)
+{
+    int index, line, k = 0;
+    if (sscanf(msg, "lens2pov-camera %d %d %d", &index, &line, &k) < 3 || k < 1 ||
+        k >= files->count)
+        k = 0;
+    return files->path[k];
+}
+
+int scene_camera_from_log(const char *log, size_t n, const scene_files *files,
+                          scene_camera *out, l2p_error *err)
 {
     /* The last statement that ran: it replaces every earlier one entirely (POV-Ray 3.7 starts
        each camera statement from the default camera). */
@@ -275,13 +292,14 @@ int scene_camera_from_log(const char *log, size_t n, const char *scene, scene_ca
         pov_camera c;
         pov_camera_default(&c);
         c.focus = v3(0, 0, 1);
-        int st = to_scene_camera(&c, scene, 0, out, err);
+        int st = to_scene_camera(&c, files->path[0], 0, out, err);
         out->found = false;
         return st;
     }
     pos = last;
     next_message(log, n, &pos, buf, sizeof buf);
     sscanf(buf, "lens2pov-camera %d %d", &index, &line);
+    const char *scene = file_of(buf, files);
     pov_camera c;
     pov_camera_default(&c);
     int st = L2P_OK;
@@ -310,8 +328,8 @@ static void take_frame(const char *msg, scene_frames *out, scene_frame *f)
     }
 }
 
-int scene_frames_from_log(const char *log, size_t n, const char *scene, scene_frames *out,
-                          l2p_error *err)
+int scene_frames_from_log(const char *log, size_t n, const scene_files *files,
+                          scene_frames *out, l2p_error *err)
 {
     memset(out, 0, sizeof *out);
     char buf[4096];
@@ -328,11 +346,11 @@ int scene_frames_from_log(const char *log, size_t n, const char *scene, scene_fr
         if (strncmp(buf, "lens2pov-frame ", 15))
             continue;
         if (k >= 0)
-            st = scene_camera_from_log(log + start, at - start, scene, &out->frame[k].cam, err);
+            st = scene_camera_from_log(log + start, at - start, files, &out->frame[k].cam, err);
         take_frame(buf, out, &out->frame[++k]);
         start = at;
     }
     if (!st)
-        st = scene_camera_from_log(log + start, n - start, scene, &out->frame[k].cam, err);
+        st = scene_camera_from_log(log + start, n - start, files, &out->frame[k].cam, err);
     return st;
 }

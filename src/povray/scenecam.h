@@ -19,7 +19,7 @@ typedef struct scene_camera {
     double focus_distance;     /* along forward to the look_at point (else |direction|) */
     double hfov_deg;           /* horizontal angle: 2 atan(|right| / (2 |direction|)) */
     bool found;                /* false: no camera statement ran, POV-Ray's default camera */
-    int line;                  /* the statement's line in the scene (0 when not found) */
+    int line;                  /* the statement's line in its file (0 when not found) */
 } scene_camera;
 
 /* Runs POV-Ray on a copy of the scene at width x height (image_width and image_height read so)
@@ -50,14 +50,37 @@ int scene_frames_read(const char *scene_path, int width, int height, char *const
                       int arg_count, scene_frames *out, l2p_error *err);
 void scene_frames_free(scene_frames *f);
 
+/* The files the probe's messages name: path[0] the scene, path[k] the k-th included file
+   whose copy prints its camera statements (scene_copy_make). */
+typedef struct scene_files {
+    const char *const *path;
+    int count;
+} scene_files;
+
 /* The frames of POV-Ray's output: from each "lens2pov-frame" message to the next, one
    camera (scene_camera_from_log). */
-int scene_frames_from_log(const char *log, size_t n, const char *scene, scene_frames *out,
-                          l2p_error *err);
+int scene_frames_from_log(const char *log, size_t n, const scene_files *files,
+                          scene_frames *out, l2p_error *err);
 
 /* The copy's text: every camera statement of text replaced by its #debug lines, on as many
    lines as the statement took, so that POV-Ray's messages keep their line numbers. */
 char *scene_camera_rewrite(const char *text, size_t n);
+/* The same for file number file (scene_files), which the messages then carry. */
+char *scene_camera_rewrite_file(const char *text, size_t n, int file);
+
+/* The probe's copy of a scene: its text rewritten, and every file it includes from its own
+   folder (nested too) that holds a camera statement, or includes one that does, copied into
+   work rewritten as file number k; each #include of such a file points at its copy. */
+typedef struct scene_copy {
+    char *text;                /* the scene's copy */
+    char **path, **copy;       /* [k], k >= 1: an included file, as the scene's folder names
+                                  it, and its copy in work ([0] the scene, no copy) */
+    int count;
+} scene_copy;
+int scene_copy_make(const char *scene, const char *text, size_t n, const char *work,
+                    scene_copy *out, l2p_error *err);
+/* Removes the included files' copies and frees c. */
+void scene_copy_free(scene_copy *c);
 
 /* What the probe's copy of text would print, frame and camera, when the scene's camera needs
    no POV-Ray to evaluate: every camera statement outside #if, #while, #macro and other blocks,
@@ -66,10 +89,10 @@ char *scene_camera_rewrite(const char *text, size_t n);
    scene without a camera statement). */
 char *scene_camera_literal_log(const char *text, size_t n);
 
-/* The camera from the #debug lines of POV-Ray's output (log, n bytes); scene names the scene
-   in messages. */
-int scene_camera_from_log(const char *log, size_t n, const char *scene, scene_camera *out,
-                          l2p_error *err);
+/* The camera from the #debug lines of POV-Ray's output (log, n bytes); files name the scene
+   and its rewritten includes in messages. */
+int scene_camera_from_log(const char *log, size_t n, const scene_files *files,
+                          scene_camera *out, l2p_error *err);
 
 /* Calls visit with the name and line of every `#include "NAME"` of text (not in comments),
    in order, until it returns false. */
@@ -79,10 +102,5 @@ void scene_text_includes(const char *text, size_t n, scene_include_visit visit, 
 /* Whether text has a camera statement scene_camera_rewrite would replace; *line gets the
    first one's line. */
 bool scene_text_has_camera(const char *text, size_t n, int *line);
-
-/* L2P_BAD_INPUT, naming the scene's #include line and the camera's file and line, when a file
-   the scene includes from its own folder (as POV-Ray finds it, run there) has a camera
-   statement: the probe rewrites only the scene's own text, so that camera would be missed. */
-int scene_camera_check_includes(const char *scene_path, l2p_error *err);
 
 #endif

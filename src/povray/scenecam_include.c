@@ -1,24 +1,48 @@
-/* Cameras the probe would miss: a statement in a file the scene includes from its folder. The
-   probe copies and rewrites the scene's own text only; POV-Ray, run in the scene's folder,
-   finds an #include there first (docs/povray.md), and a camera statement in such a file
-   would run unseen. Standard includes (the library path) set no camera and are not read. */
+/* The probe's copy of a scene and of the files it includes. A camera statement in an included
+   file runs where the #include stands, so such a file is copied too, its statements printing
+   their items under the file's number (scene_camera_rewrite_file), and the #include that
+   reads it is pointed at the copy; so is every file on the way to it. POV-Ray, run in the
+   scene's folder, finds a relative #include there first (docs/povray.md); the standard
+   includes (the library path) set no camera and are not read. */
 #include "povray/scenecam.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 enum { MAX_DEPTH = 8, NAME_MAX_BYTES = 1024 };
 
-typedef struct walk {
-    const char *scene;        /* for messages */
-    const char *folder;       /* the scene's folder, where POV-Ray runs */
-    int depth, scene_line;    /* the scene's #include line that led here */
+typedef struct seen {
+    char *path;
+    int file;                  /* its number in the copy, 0 when it needs none */
+    bool open;                 /* being read: an #include of itself is not followed */
+} seen;
+
+typedef struct copier {
+    const char *folder, *work;
+    seen *seen;
+    int seen_count, seen_cap;
+    scene_copy *out;
     l2p_error *err;
     int status;
-} walk;
+} copier;
 
-static char *read_file(const char *path, size_t *n)
+/* The #includes of one text whose files have copies: where each name stands, which copy. */
+typedef struct swap {
+    size_t at, len;
+    int file;
+} swap;
+
+typedef struct swaps {
+    const char *text;
+    swap *swap;
+    int count, cap, depth;
+    copier *c;
+} swaps;
+
+static char *read_text(const char *path, size_t *n)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
@@ -26,79 +50,196 @@ static char *read_file(const char *path, size_t *n)
     char *s = NULL;
     size_t cap = 0;
     *n = 0;
-    for (;;) {
+    for (size_t got = 1; got > 0;) {
         if (*n + 4096 + 1 > cap) {
             char *grown = realloc(s, cap = 2 * cap + 8192);
             if (!grown)
                 break;
             s = grown;
         }
-        const size_t got = fread(s + *n, 1, 4096, f);
-        *n += got;
-        if (got == 0)
-            break;
+        *n += got = fread(s + *n, 1, 4096, f);
     }
     fclose(f);
     if (s)
         s[*n] = '\0';
+    if (s && memchr(s, '\0', *n)) {   /* not text: POV-Ray will say what it makes of it */
+        free(s);
+        return NULL;
+    }
     return s;
 }
 
-static void check_text(walk *w, const char *text, size_t n);
-
-static bool visit(const char *name, size_t len, int line, void *ctx)
+static int out_of_memory(copier *c)
 {
-    walk *w = ctx;
-    if (len == 0 || len >= NAME_MAX_BYTES)
+    if (!c->status)
+        c->status = l2p_fail(c->err, L2P_FAILED, NULL, 0, "out of memory");
+    return c->status;
+}
+
+/* A new file number for path, with no copy yet; -1 when out of memory. */
+static int add_file(copier *c, const char *path)
+{
+    scene_copy *o = c->out;
+    char **p = realloc(o->path, (size_t)(o->count + 1) * sizeof *p);
+    if (p)
+        o->path = p;
+    char **q = p ? realloc(o->copy, (size_t)(o->count + 1) * sizeof *q) : NULL;
+    if (q)
+        o->copy = q;
+    if (!p || !q || !(o->path[o->count] = strdup(path)))
+        return out_of_memory(c), -1;
+    o->copy[o->count] = NULL;
+    return o->count++;
+}
+
+static char *copy_text(copier *c, const char *path, const char *text, size_t n, int depth,
+                       int *file);
+
+/* The file number of the copy of the file at path, 0 when it needs none. */
+static int copy_of(copier *c, const char *path, int depth)
+{
+    for (int i = 0; i < c->seen_count; i++)
+        if (!strcmp(c->seen[i].path, path))
+            return c->seen[i].open ? 0 : c->seen[i].file;
+    if (c->seen_count == c->seen_cap) {
+        seen *grown = realloc(c->seen, (size_t)(c->seen_cap = 2 * c->seen_cap + 8) * sizeof *grown);
+        if (!grown)
+            return out_of_memory(c), 0;
+        c->seen = grown;
+    }
+    const int at = c->seen_count;
+    if (!(c->seen[at].path = strdup(path)))
+        return out_of_memory(c), 0;
+    c->seen[at].file = 0;
+    c->seen[at].open = true;
+    c->seen_count++;
+    size_t n;
+    char *text = read_text(path, &n);   /* unreadable: a library include, or POV-Ray's error */
+    int file = -1;
+    char *copy = text ? copy_text(c, path, text, n, depth, &file) : NULL;
+    free(text);
+    if (copy) {
+        char name[4200];
+        snprintf(name, sizeof name, "%s/include-%d.inc", c->work, file);
+        FILE *f = fopen(name, "wb");
+        const bool ok = f && fputs(copy, f) >= 0;
+        if ((f && fclose(f) != 0) || !ok)
+            c->status = l2p_fail(c->err, L2P_FAILED, name, 0, "cannot write: %s", strerror(errno));
+        else if (!(c->out->copy[file] = strdup(name)))
+            out_of_memory(c);
+        else
+            c->seen[at].file = file;
+    }
+    free(copy);
+    c->seen[at].open = false;
+    return c->seen[at].file;
+}
+
+static bool collect(const char *name, size_t len, int line, void *ctx)
+{
+    (void)line;
+    swaps *s = ctx;
+    copier *c = s->c;
+    if (len == 0 || len >= NAME_MAX_BYTES || s->depth >= MAX_DEPTH)
         return true;
     char path[4096 + NAME_MAX_BYTES + 2];
     if (name[0] == '/')
         snprintf(path, sizeof path, "%.*s", (int)len, name);
     else
-        snprintf(path, sizeof path, "%s/%.*s", w->folder, (int)len, name);
-    size_t n;
-    char *text = read_file(path, &n);
-    if (!text)
-        return true;   /* a library include, or one POV-Ray will report */
-    const int scene_line = w->scene_line;
-    if (w->depth == 0)
-        w->scene_line = line;
-    int at;
-    if (scene_text_has_camera(text, n, &at))
-        w->status = l2p_fail(w->err, L2P_BAD_INPUT, w->scene, w->scene_line,
-                             "the camera is set in %s (line %d), a file the scene includes: "
-                             "lens2pov reads only the scene's own camera statements; give "
-                             "--location and --look-at", path, at);
-    else if (w->depth < MAX_DEPTH) {
-        w->depth++;
-        check_text(w, text, n);
-        w->depth--;
+        snprintf(path, sizeof path, "%s/%.*s", c->folder, (int)len, name);
+    const int file = copy_of(c, path, s->depth + 1);
+    if (file > 0 && s->count == s->cap) {
+        swap *grown = realloc(s->swap, (size_t)(s->cap = 2 * s->cap + 8) * sizeof *grown);
+        if (!grown)
+            return out_of_memory(c), false;
+        s->swap = grown;
     }
-    w->scene_line = scene_line;
-    free(text);
-    return w->status == L2P_OK;
+    if (file > 0)
+        s->swap[s->count++] = (swap){(size_t)(name - s->text), len, file};
+    return c->status == L2P_OK;
 }
 
-static void check_text(walk *w, const char *text, size_t n)
+/* text with each #include name that has a copy replaced by the copy's path. */
+static char *swap_names(const swaps *s, size_t n, const scene_copy *o)
 {
-    scene_text_includes(text, n, visit, w);
+    size_t size = n + 1;
+    for (int i = 0; i < s->count; i++)
+        size += strlen(o->copy[s->swap[i].file]);
+    char *out = malloc(size), *p = out;
+    size_t from = 0;
+    for (int i = 0; out && i < s->count; i++) {
+        const swap *w = &s->swap[i];
+        memcpy(p, s->text + from, w->at - from);
+        p += w->at - from;
+        p += sprintf(p, "%s", o->copy[w->file]);
+        from = w->at + w->len;
+    }
+    if (out) {
+        memcpy(p, s->text + from, n - from);
+        p[n - from] = '\0';
+    }
+    return out;
 }
 
-int scene_camera_check_includes(const char *scene_path, l2p_error *err)
+/* The copy of text, the file at path: its includes' copies swapped in, its camera statements
+   rewritten as file *file, for which a negative *file asks a new number. NULL when text needs
+   no copy (no camera statement in it nor in what it includes, and a new number asked for) or
+   on failure (c->status). */
+static char *copy_text(copier *c, const char *path, const char *text, size_t n, int depth,
+                       int *file)
 {
-    size_t n;
-    char *text = read_file(scene_path, &n);
-    if (!text)
-        return L2P_OK;   /* the probe reports an unreadable scene */
+    swaps s = {text, NULL, 0, 0, depth, c};
+    scene_text_includes(text, n, collect, &s);
+    int line;
+    char *swapped = NULL, *copy = NULL;
+    if (!c->status && (*file >= 0 || s.count > 0 || scene_text_has_camera(text, n, &line))) {
+        if (*file < 0)
+            *file = add_file(c, path);
+        swapped = *file >= 0 ? swap_names(&s, n, c->out) : NULL;
+        copy = swapped ? scene_camera_rewrite_file(swapped, strlen(swapped), *file) : NULL;
+        if (!copy)
+            out_of_memory(c);
+    }
+    free(swapped);
+    free(s.swap);
+    return copy;
+}
+
+int scene_copy_make(const char *scene, const char *text, size_t n, const char *work,
+                    scene_copy *out, l2p_error *err)
+{
+    memset(out, 0, sizeof *out);
     char folder[4096];
-    snprintf(folder, sizeof folder, "%s", scene_path);
+    snprintf(folder, sizeof folder, "%s", scene);
     char *slash = strrchr(folder, '/');
     if (slash)
         *slash = '\0';
     else
         snprintf(folder, sizeof folder, ".");
-    walk w = {scene_path, folder, 0, 0, err, L2P_OK};
-    check_text(&w, text, n);
-    free(text);
-    return w.status;
+    copier c = {folder, work, NULL, 0, 0, out, err, L2P_OK};
+    int file = add_file(&c, scene);
+    if (file == 0)
+        out->text = copy_text(&c, scene, text, n, 0, &file);
+    for (int i = 0; i < c.seen_count; i++)
+        free(c.seen[i].path);
+    free(c.seen);
+    if (!c.status && !out->text)
+        out_of_memory(&c);
+    if (c.status)
+        scene_copy_free(out);
+    return c.status;
+}
+
+void scene_copy_free(scene_copy *c)
+{
+    for (int k = 0; k < c->count; k++) {
+        if (c->copy[k])
+            unlink(c->copy[k]);
+        free(c->copy[k]);
+        free(c->path[k]);
+    }
+    free(c->path);
+    free(c->copy);
+    free(c->text);
+    memset(c, 0, sizeof *c);
 }

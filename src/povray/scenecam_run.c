@@ -306,61 +306,90 @@ static int one_default_frame(const char *scene, scene_frames *out, l2p_error *er
     if (!out->frame)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     out->count = 1;
-    return scene_camera_from_log("", 0, scene, &out->frame[0].cam, err);
+    const scene_files files = {&scene, 1};
+    return scene_camera_from_log("", 0, &files, &out->frame[0].cam, err);
+}
+
+/* POV-Ray's error, in the user's files: the copies name the scene and its included files. */
+static void probe_error(const char *scene, const char *dir, const char *top, const char *copy,
+                        const char *log, const scene_copy *sc, l2p_error *err)
+{
+    povray_path_link *links = calloc((size_t)sc->count, sizeof *links);
+    if (!links) {
+        l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+        return;
+    }
+    links[0] = (povray_path_link){(char *)copy, (char *)scene};
+    for (int k = 1; k < sc->count; k++)
+        links[k] = (povray_path_link){sc->copy[k], sc->path[k]};
+    const povray_log_names names = {scene, dir, {top, NULL}, links, sc->count};
+    if (!povray_log_error(log, &names, err))
+        l2p_fail(err, L2P_FAILED, scene, 0, "POV-Ray failed reading the scene's camera");
+    free(links);
+}
+
+static int run_copy(const char *scene, const char *dir, const char *work, int w, int h,
+                    const probe_args *pa, const scene_copy *sc, scene_frames *out,
+                    l2p_error *err)
+{
+    char copy[4200], top[4200], log[4200];
+    snprintf(log, sizeof log, "%s/scene-camera.log", work);
+    int st = write_probe_files(work, sc->text, copy, top, sizeof copy, err);
+    if (!st) {
+        st = run_probe(dir, top, log, w, h, pa, err);
+        if (st < 0 && pa->user_count && refused_options(log, pa, err))
+            st = L2P_BAD_INPUT;
+        if (st < 0) {
+            probe_error(scene, dir, top, copy, log, sc, err);
+            st = L2P_FAILED;
+        }
+    }
+    size_t n = 0;
+    char *out_log = st ? NULL : read_all(log, &n);
+    if (!st && !out_log)
+        st = l2p_fail(err, L2P_FAILED, log, 0, "cannot read: %s", strerror(errno));
+    const scene_files files = {(const char *const *)sc->path, sc->count};
+    if (!st)
+        st = scene_frames_from_log(out_log, n, &files, out, err);
+    free(out_log);
+    unlink(copy);
+    unlink(top);
+    unlink(log);
+    return st;
 }
 
 static int probe(const char *scene, const char *dir, const char *work, int w, int h,
                  const probe_args *pa, scene_frames *out, l2p_error *err)
 {
-    char copy[4200], top[4200], log[4200];
-    snprintf(log, sizeof log, "%s/scene-camera.log", work);
     size_t n = 0;
     char *text = read_all(scene, &n);
     if (!text)
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
-    char *rewritten = memchr(text, '\0', n) ? NULL : scene_camera_rewrite(text, n);
-    const bool no_camera = rewritten && !strcmp(rewritten, text);
-    if (!rewritten) {
+    if (memchr(text, '\0', n)) {
         free(text);
-        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file (or out of memory)");
+        return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file");
     }
-    if (no_camera && pa->user_count == 0) {   /* POV-Ray's default camera, one frame */
-        free(rewritten);
+    scene_copy sc;
+    int st = scene_copy_make(scene, text, n, work, &sc, err);
+    if (st) {
         free(text);
-        return one_default_frame(scene, out, err);
-    }
-    char *literal = pa->user_count || settings_may_differ(dir) ? NULL
-                                                               : scene_camera_literal_log(text, n);
-    free(text);
-    if (literal) {   /* what POV-Ray would print, without running it */
-        free(rewritten);
-        const int st = scene_frames_from_log(literal, strlen(literal), scene, out, err);
-        free(literal);
         return st;
     }
-    int st = write_probe_files(work, rewritten, copy, top, sizeof copy, err);
-    free(rewritten);
-    if (!st) {
-        st = run_probe(dir, top, log, w, h, pa, err);
-        if (st < 0 && pa->user_count && refused_options(log, pa, err))
-            st = L2P_BAD_INPUT;
-        if (st < 0) {   /* POV-Ray's own error, in the user's file */
-            const povray_path_link link = {copy, (char *)scene};
-            const povray_log_names names = {scene, dir, {top, NULL}, &link, 1};
-            if (!povray_log_error(log, &names, err))
-                l2p_fail(err, L2P_FAILED, scene, 0, "POV-Ray failed reading the scene's camera");
-            st = L2P_FAILED;
-        }
+    const bool own_text_only = sc.count == 1;   /* no included file has a camera */
+    if (own_text_only && pa->user_count == 0 && !strcmp(sc.text, text)) {
+        st = one_default_frame(scene, out, err);   /* POV-Ray's default camera, one frame */
+    } else {
+        char *literal = own_text_only && !pa->user_count && !settings_may_differ(dir)
+                            ? scene_camera_literal_log(text, n) : NULL;
+        const scene_files files = {&scene, 1};
+        if (literal)   /* what POV-Ray would print, without running it */
+            st = scene_frames_from_log(literal, strlen(literal), &files, out, err);
+        else
+            st = run_copy(scene, dir, work, w, h, pa, &sc, out, err);
+        free(literal);
     }
-    char *out_log = st ? NULL : read_all(log, &n);
-    if (!st && !out_log)
-        st = l2p_fail(err, L2P_FAILED, log, 0, "cannot read: %s", strerror(errno));
-    if (!st)
-        st = scene_frames_from_log(out_log, n, scene, out, err);
-    free(out_log);
-    unlink(copy);
-    unlink(top);
-    unlink(log);
+    scene_copy_free(&sc);
+    free(text);
     return st;
 }
 

@@ -247,18 +247,77 @@ static int count_lines(const char *s, size_t a, size_t b)
     return lines;
 }
 
-/* One camera statement: "camera" at s[kw], its body s[open + 1, close). */
+/* Past the ')' matching the '(' at i, or i when there is none there. */
+static size_t paren_end(const char *s, size_t close, size_t i)
+{
+    int depth = 0;
+    for (size_t j = i; j < close; j = token_end(s, close, j)) {
+        j = skip_blank(s, close, j);
+        if (j >= close || (j == i && s[j] != '('))
+            break;
+        depth += (s[j] == '(') - (s[j] == ')');
+        if (depth == 0)
+            return j + 1;
+    }
+    return i;
+}
+
+/* Where a directive that may stand inside a camera block ends, '#' at s[a]: a conditional
+   (#if (...), #else, #end, #switch, ...), copied as written, so that the #debug lines of the
+   items it holds run as the items would, or a #debug or #warning of a string. a for any other
+   directive. */
+static size_t directive_end(const char *s, size_t close, size_t a)
+{
+    static const char *const plain[] = {"else", "end", "break"};
+    /* Not #while: without #declare, which may not stand here, it would never end. */
+    static const char *const with_test[] = {"if", "ifdef", "ifndef", "elseif", "switch", "case",
+                                            "range"};
+    const size_t w = skip_blank(s, close, a + 1), we = w < close ? token_end(s, close, w) : w;
+    const size_t p = skip_blank(s, close, we);
+    for (size_t k = 0; k < sizeof plain / sizeof *plain; k++)
+        if (is_word(s, w, we, plain[k]))
+            return we;
+    for (size_t k = 0; k < sizeof with_test / sizeof *with_test; k++)
+        if (is_word(s, w, we, with_test[k])) {
+            const size_t q = paren_end(s, close, p);
+            return q > p ? q : a;
+        }
+    if ((is_word(s, w, we, "debug") || is_word(s, w, we, "warning")) && p < close && s[p] == '"')
+        return token_end(s, close, p);
+    return a;
+}
+
+/* Whether every directive in the camera block s(open, close) is one directive_end passes. */
+static bool directives_pass(const char *s, size_t open, size_t close)
+{
+    for (size_t i = skip_blank(s, close, open + 1); i < close;) {
+        const size_t e = s[i] == '#' ? directive_end(s, close, i) : token_end(s, close, i);
+        if (e == i)
+            return false;
+        i = skip_blank(s, close, e);
+    }
+    return true;
+}
+
+/* One camera statement: "camera" at s[kw], its body s[open + 1, close), of file number file
+   (0: the scene; an included file's number follows the line). */
 static void put_camera(text *t, const char *s, size_t kw, size_t open, size_t close, int index,
-                       int line)
+                       int line, int file)
 {
     const size_t start = t->n;
-    char head[160];
+    char head[160], file_number[16] = "";
+    if (file > 0)
+        snprintf(file_number, sizeof file_number, " %d", file);
     snprintf(head, sizeof head,
-             "#debug concat(\"\\nlens2pov-camera %d %d|\\n\", \"\\nlens2pov-version \", "
-             "str(version, 0, 3), \"|\\n\") ", index, line);
+             "#debug concat(\"\\nlens2pov-camera %d %d%s|\\n\", \"\\nlens2pov-version \", "
+             "str(version, 0, 3), \"|\\n\") ", index, line, file_number);
     puts_(t, head);
     size_t i = skip_blank(s, close, open + 1);
     bool perspective = true;
+    if (!directives_pass(s, open, close)) {
+        puts_(t, "#debug \"\\nlens2pov-directive|\\n\" ");
+        i = close;
+    }
     if (i < close && ident_char(s[i]) && !isdigit((unsigned char)s[i])) {
         const size_t e = token_end(s, close, i);
         if (item_kind(s, i, e) == ITEM_NONE) {   /* camera { Declared_Camera ... } */
@@ -266,17 +325,27 @@ static void put_camera(text *t, const char *s, size_t kw, size_t open, size_t cl
             i = close;
         }
     }
+    bool items = true;   /* false past an unknown word: only directives are copied then */
     while (i < close) {
         const size_t a = i, b = token_end(s, close, i);
         const enum item_kind kind = item_kind(s, a, b);
-        if (s[a] == '#') {
-            puts_(t, "#debug \"\\nlens2pov-directive|\\n\" ");
-            break;
+        if (s[a] == '#') {   /* directives_pass has passed it */
+            i = directive_end(s, close, a);
+            put_expression(t, s, a, i);
+            puts_(t, " ");
+            i = skip_blank(s, close, i);
+            continue;
+        }
+        if (!items) {
+            i = skip_blank(s, close, b);
+            continue;
         }
         const size_t e = item_end(s, close, b);
         if (kind == ITEM_NONE) {
             puts_(t, "#debug \"\\nlens2pov-unknown|\\n\" ");
-            break;
+            items = false;
+            i = skip_blank(s, close, b);
+            continue;
         }
         if (kind == ITEM_TYPE)
             perspective = is_word(s, a, b, "perspective");
@@ -352,7 +421,9 @@ static bool walk_directive(const walk *w)
     return w->prev_b == w->prev_a + 1 && w->s[w->prev_a] == '#';
 }
 
-char *scene_camera_rewrite(const char *s, size_t n)
+char *scene_camera_rewrite(const char *s, size_t n) { return scene_camera_rewrite_file(s, n, 0); }
+
+char *scene_camera_rewrite_file(const char *s, size_t n, int file)
 {
     text t = {0};
     size_t copied = 0, open, close;
@@ -360,7 +431,7 @@ char *scene_camera_rewrite(const char *s, size_t n)
     for (walk w = walk_start(s, n); walk_next(&w);)
         if (walk_camera(&w, &open, &close)) {
             put(&t, s + copied, w.a - copied);
-            put_camera(&t, s, w.a, open, close > open ? close - 1 : open, index++, w.line);
+            put_camera(&t, s, w.a, open, close > open ? close - 1 : open, index++, w.line, file);
             walk_past(&w, copied = close);
         }
     put(&t, s + copied, n - copied);
