@@ -123,9 +123,10 @@ static int copy_of(copier *c, const char *path, int depth)
         snprintf(name, sizeof name, "%s/include-%d.inc", c->work, file);
         FILE *f = fopen(name, "wb");
         const bool ok = f && fputs(copy, f) >= 0;
-        if ((f && fclose(f) != 0) || !ok)
+        if ((f && fclose(f) != 0) || !ok) {
             c->status = l2p_fail(c->err, L2P_FAILED, name, 0, "cannot write: %s", strerror(errno));
-        else if (!(c->out->copy[file] = strdup(name)))
+            unlink(name);
+        } else if (!(c->out->copy[file] = strdup(name)))
             out_of_memory(c);
         else
             c->seen[at].file = file;
