@@ -159,10 +159,11 @@ Test(scene_camera, other_directives_and_unknown_words_are_refused)
     }
 }
 
-/* A camera in a file the scene includes from its folder, nested two deep, after a camera of
-   the scene's own: it is the last to run, so it is the camera, its expressions evaluated
-   where its file stands. A standard include is not copied; comments that look like a camera
-   or an #include do not count. */
+/* A camera in a file the scene includes from its folder, nested two deep (the inner one
+   named without its ".inc", which POV-Ray appends), after a camera of the scene's own: it is
+   the last to run, so it is the camera, its expressions evaluated where its file stands. A
+   standard include is not copied; comments that look like a camera or an #include do not
+   count. */
 Test(scene_camera, a_camera_in_an_included_file_is_the_camera)
 {
     const char *dir = test_tmpdir();
@@ -170,7 +171,7 @@ Test(scene_camera, a_camera_in_an_included_file_is_the_camera)
     snprintf(outer, sizeof outer, "%s/outer.inc", dir);
     snprintf(inner, sizeof inner, "%s/inner.inc", dir);
     write_text(inner, "// camera { location 0 }\n\n" CAMERA("x"));
-    write_text(outer, "/* #include \"nothing.inc\" */\n#include \"inner.inc\"\n");
+    write_text(outer, "/* #include \"nothing.inc\" */\n#include \"inner\"\n");
     expect_markers_in(dir, MARKERS_HEAD "camera { location <5, 5, 5> look_at 0 angle 80 }\n"
                            "#include \"colors.inc\"\n#include \"outer.inc\"\n");
 }

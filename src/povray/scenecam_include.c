@@ -136,6 +136,27 @@ static int copy_of(copier *c, const char *path, int depth)
     return c->seen[at].file;
 }
 
+/* The file an #include of name (len bytes) reads, into path, as POV-Ray 3.7 looks for it
+   (SceneData::FindFile): a name ending in ".inc" or ".INC" as it is, then with ".inc" and
+   ".INC" appended, then any other name as it is; relative names in folder. */
+static bool find_include(const char *folder, const char *name, size_t len, char *path,
+                         size_t size)
+{
+    const bool standard = len > 4 && (!memcmp(name + len - 4, ".inc", 4) ||
+                                      !memcmp(name + len - 4, ".INC", 4));
+    const char *const suffixes[] = {standard ? "" : ".inc", standard ? ".inc" : ".INC",
+                                    standard ? ".INC" : ""};
+    for (int k = 0; k < 3; k++) {
+        if (name[0] == '/' || !strcmp(folder, "."))
+            snprintf(path, size, "%.*s%s", (int)len, name, suffixes[k]);
+        else
+            snprintf(path, size, "%s/%.*s%s", folder, (int)len, name, suffixes[k]);
+        if (access(path, F_OK) == 0)
+            return true;
+    }
+    return false;
+}
+
 static bool collect(const char *name, size_t len, int line, void *ctx)
 {
     (void)line;
@@ -143,12 +164,9 @@ static bool collect(const char *name, size_t len, int line, void *ctx)
     copier *c = s->c;
     if (len == 0 || len >= NAME_MAX_BYTES || s->depth >= MAX_DEPTH)
         return true;
-    char path[4096 + NAME_MAX_BYTES + 2];
-    if (name[0] == '/')
-        snprintf(path, sizeof path, "%.*s", (int)len, name);
-    else
-        snprintf(path, sizeof path, "%s/%.*s", c->folder, (int)len, name);
-    const int file = copy_of(c, path, s->depth + 1);
+    char path[4096 + NAME_MAX_BYTES + 8];
+    const int file = find_include(c->folder, name, len, path, sizeof path)
+                         ? copy_of(c, path, s->depth + 1) : 0;
     if (file > 0 && s->count == s->cap) {
         swap *grown = realloc(s->swap, (size_t)(s->cap = 2 * s->cap + 8) * sizeof *grown);
         if (!grown)
