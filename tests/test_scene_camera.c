@@ -34,28 +34,33 @@
     "camera {\n  location Lift(Eye) // where it stands\n  look_at Target\n  angle 40\n"        \
     "  right " right " * image_width / image_height\n}\n"
 
-static void povray_render(const char *dir, const char *scene, const char *out)
+/* POV-Ray's own picture of the scene, with the option opt ("" for none). */
+static void povray_render(const char *dir, const char *scene, const char *out, const char *opt)
 {
-    char cmd[1024];
+    char cmd[1600];
     snprintf(cmd, sizeof cmd,
-             "cd '%s' && povray +I%s +O%s +W64 +H48 +FN -A -D -V -GA >povray.log 2>&1", dir,
-             scene, out);
+             "cd '%s' && povray +I%s +O%s +W64 +H48 +FN -A -D -V -GA %s >povray.log 2>&1", dir,
+             scene, out, opt);
     cr_assert_eq(system_povray(cmd), 0, "%s", cmd);
 }
 
 /* The scene, in dir, through the lens, with no placement and --angle scene, against POV-Ray's
-   camera. */
-static void expect_markers_in(const char *dir, const char *scene_text)
+   camera; library, when not NULL, a folder given to both as +L. */
+static void expect_markers_in(const char *dir, const char *scene_text, const char *library)
 {
-    char scene[512], own[512], lens[512];
+    char scene[512], own[512], lens[512], opt[600] = "";
     snprintf(scene, sizeof scene, "%s/scene.pov", dir);
     snprintf(own, sizeof own, "%s/own.png", dir);
     snprintf(lens, sizeof lens, "%s/lens.png", dir);
+    if (library)
+        snprintf(opt, sizeof opt, "+L%s", library);
     write_text(scene, scene_text);
-    povray_render(dir, "scene.pov", "own.png");
+    povray_render(dir, "scene.pov", "own.png", opt);
     char *errtext = NULL;
-    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "4", "--angle",
-                       "scene", "--jobs", "1", "-q", "-o", lens);
+    const int st = library ? L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "4",
+                                 "--angle", "scene", "--jobs", "1", "-q", "-o", lens, "--", opt)
+                           : L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "4",
+                                 "--angle", "scene", "--jobs", "1", "-q", "-o", lens);
     cr_assert_eq(st, 0, "render failed: %s", errtext ? errtext : "");
     free(errtext);
     for (int c = 0; c < 3; c++) {
@@ -70,7 +75,7 @@ static void expect_markers_in(const char *dir, const char *scene_text)
 
 static void expect_markers_as_povray(const char *scene_text)
 {
-    expect_markers_in(test_tmpdir(), scene_text);
+    expect_markers_in(test_tmpdir(), scene_text, NULL);
 }
 
 Test(scene_camera, declared_vectors_expression_and_angle)
@@ -173,7 +178,24 @@ Test(scene_camera, a_camera_in_an_included_file_is_the_camera)
     write_text(inner, "// camera { location 0 }\n\n" CAMERA("x"));
     write_text(outer, "/* #include \"nothing.inc\" */\n#include \"inner\"\n");
     expect_markers_in(dir, MARKERS_HEAD "camera { location <5, 5, 5> look_at 0 angle 80 }\n"
-                           "#include \"colors.inc\"\n#include \"outer.inc\"\n");
+                           "#include \"colors.inc\"\n#include \"outer.inc\"\n", NULL);
+}
+
+/* Included files are found on POV-Ray's library path as POV-Ray finds them: a folder of the
+   user's given as +L after "--", and the standard includes, where screen.inc sets the camera
+   in a macro (without look_at: the lens focuses at the direction's length, within a pixel of
+   blur here). */
+Test(scene_camera, cameras_on_the_library_path)
+{
+    const char *dir = test_tmpdir();
+    char library[512], inc[600];
+    snprintf(library, sizeof library, "%s/lib", dir);
+    snprintf(inc, sizeof inc, "%s/cam.inc", library);
+    cr_assert_eq(mkdir(library, 0777), 0);
+    write_text(inc, CAMERA("x"));
+    expect_markers_in(dir, MARKERS_HEAD "#include \"cam.inc\"\n", library);
+    expect_markers_as_povray(MARKERS_HEAD "#include \"screen.inc\"\n"
+                             "Set_Camera(Lift(Eye), Target, 40)\n");
 }
 
 /* What is wrong with a camera in an included file is reported in that file's name and line:

@@ -154,3 +154,114 @@ char *povargs_frame_name(const char *path, int frame, int digits)
         snprintf(s, n, "%.*s%0*d%s", (int)(dot - path), path, digits, frame, dot);
     return s;
 }
+
+/* ---------------------------------------------------------------- the library path */
+
+typedef struct paths {
+    char **dir;
+    int count, cap;
+    bool failed;
+} paths;
+
+/* dir (len bytes, quotes trimmed) onto the list, relative to folder when relative. */
+static void add_path(paths *p, const char *folder, const char *dir, size_t len)
+{
+    while (len > 0 && isspace((unsigned char)dir[len - 1]))
+        len--;
+    if (len >= 2 && dir[0] == '"' && dir[len - 1] == '"')
+        dir++, len -= 2;
+    if (len == 0 || p->failed)
+        return;
+    if (p->count + 1 >= p->cap) {
+        char **grown = realloc(p->dir, (size_t)(p->cap = 2 * p->cap + 8) * sizeof *grown);
+        if (!grown) {
+            p->failed = true;
+            return;
+        }
+        p->dir = grown;
+    }
+    const size_t n = len + strlen(folder) + 2;
+    char *s = malloc(n);
+    if (!s) {
+        p->failed = true;
+        return;
+    }
+    if (dir[0] == '/')
+        snprintf(s, n, "%.*s", (int)len, dir);
+    else
+        snprintf(s, n, "%s/%.*s", folder, (int)len, dir);
+    p->dir[p->count++] = s;
+    p->dir[p->count] = NULL;
+}
+
+/* A setting that names a library folder: +L/-L DIR or Library_Path = DIR. */
+static void take_setting(paths *p, const char *folder, const char *a, size_t len)
+{
+    while (len > 0 && isspace((unsigned char)*a))
+        a++, len--;
+    if (len > 2 && (a[0] == '+' || a[0] == '-') && (a[1] == 'L' || a[1] == 'l')) {
+        add_path(p, folder, a + 2, len - 2);
+        return;
+    }
+    static const char key[] = "Library_Path";
+    const size_t k = sizeof key - 1;
+    if (len <= k || strncasecmp(a, key, k))
+        return;
+    size_t i = k;
+    while (i < len && isspace((unsigned char)a[i]))
+        i++;
+    if (i >= len || a[i] != '=')
+        return;
+    for (i++; i < len && isspace((unsigned char)a[i]); i++)
+        continue;
+    add_path(p, folder, a + i, len - i);
+}
+
+/* The settings of an ini file, outside its ';' comments. A missing file has none. */
+static void take_ini(paths *p, const char *folder, const char *path)
+{
+    FILE *f = path ? fopen(path, "r") : NULL;
+    char line[4096];
+    while (f && fgets(line, sizeof line, f))
+        take_setting(p, folder, line, strcspn(line, ";\r\n"));
+    if (f)
+        fclose(f);
+}
+
+static bool is_ini(const char *a)
+{
+    const size_t n = strlen(a);
+    return a[0] != '+' && a[0] != '-' && !strchr(a, '=') && n > 4 &&
+           !strcasecmp(a + n - 4, ".ini");
+}
+
+char **povargs_library_paths(const char *folder, char *const *args, int count)
+{
+    paths p = {NULL, 0, 0, false};
+    char home_ini[4200], folder_ini[4200], folder_ini_caps[4200];
+    const char *home = getenv("HOME"), *povini = getenv("POVINI");
+    snprintf(home_ini, sizeof home_ini, "%s/.povray/3.7/povray.ini", home ? home : "");
+    snprintf(folder_ini, sizeof folder_ini, "%s/povray.ini", folder);
+    snprintf(folder_ini_caps, sizeof folder_ini_caps, "%s/POVRAY.INI", folder);
+    const char *inis[] = {povini && *povini ? povini : NULL, folder_ini, folder_ini_caps,
+                          home && *home ? home_ini : NULL, "/etc/povray/3.7/povray.ini"};
+    for (size_t i = 0; i < sizeof inis / sizeof *inis; i++)
+        take_ini(&p, folder, inis[i]);
+    for (int i = 0; i < count; i++) {
+        if (!is_ini(args[i])) {
+            take_setting(&p, folder, args[i], strlen(args[i]));
+            continue;
+        }
+        char ini[4200];
+        snprintf(ini, sizeof ini, "%s%s%s", args[i][0] == '/' ? "" : folder,
+                 args[i][0] == '/' ? "" : "/", args[i]);
+        take_ini(&p, folder, ini);
+    }
+    if (!p.failed && !p.dir)
+        p.dir = calloc(1, sizeof *p.dir);
+    if (p.failed) {
+        povargs_free(p.dir);
+        return NULL;
+    }
+    return p.dir;
+}

@@ -24,6 +24,13 @@ void povargs_free(char **args);
    Declare=. Any other (an ini named alone, a Post_Frame_Command=, ...) might. */
 bool povargs_end_with_pictures(char *const *args, int count);
 
+/* The folders POV-Ray looks in for an #include, after folder (where it runs), with the
+   options args: the Library_Path settings and +L options of the ini files it may read (POVINI,
+   folder/povray.ini, ~/.povray/3.7/povray.ini, /etc/povray/3.7/povray.ini), of ini files
+   among args, and of args; relative ones taken from folder. NULL-terminated, malloc'd
+   (povargs_free); NULL out of memory. */
+char **povargs_library_paths(const char *folder, char *const *args, int count);
+
 /* The digits POV-Ray pads a frame number to: those of the final frame. */
 int povargs_frame_digits(int final_frame);
 

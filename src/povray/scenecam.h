@@ -68,17 +68,18 @@ char *scene_camera_rewrite(const char *text, size_t n);
 /* The same for file number file (scene_files), which the messages then carry. */
 char *scene_camera_rewrite_file(const char *text, size_t n, int file);
 
-/* The probe's copy of a scene: its text rewritten, and every file it includes from its own
-   folder (nested too) that holds a camera statement, or includes one that does, copied into
-   work rewritten as file number k; each #include of such a file points at its copy. */
+/* The probe's copy of a scene: its text rewritten, and every file it includes (nested too;
+   found in the scene's folder, then in the library folders, NULL-terminated) that holds a
+   camera statement, or includes one that does, copied into work rewritten as file number k;
+   each #include of such a file points at its copy. */
 typedef struct scene_copy {
     char *text;                /* the scene's copy */
-    char **path, **copy;       /* [k], k >= 1: an included file, as the scene's folder names
-                                  it, and its copy in work ([0] the scene, no copy) */
+    char **path, **copy;       /* [k], k >= 1: an included file, as found, and its copy in
+                                  work ([0] the scene, no copy) */
     int count;
 } scene_copy;
 int scene_copy_make(const char *scene, const char *text, size_t n, const char *work,
-                    scene_copy *out, l2p_error *err);
+                    char *const *library, scene_copy *out, l2p_error *err);
 /* Removes the included files' copies and frees c. */
 void scene_copy_free(scene_copy *c);
 

@@ -1,9 +1,9 @@
 /* The probe's copy of a scene and of the files it includes. A camera statement in an included
    file runs where the #include stands, so such a file is copied too, its statements printing
    their items under the file's number (scene_camera_rewrite_file), and the #include that
-   reads it is pointed at the copy; so is every file on the way to it. POV-Ray, run in the
-   scene's folder, finds a relative #include there first (docs/povray.md); the standard
-   includes (the library path) set no camera and are not read. */
+   reads it is pointed at the copy; so is every file on the way to it. Files are found as
+   POV-Ray finds them: in the scene's folder, where it runs, then on its library path, where
+   standard includes such as screen.inc and stdcam.inc set cameras too (docs/povray.md). */
 #include "povray/scenecam.h"
 
 #include <errno.h>
@@ -22,6 +22,7 @@ typedef struct seen {
 
 typedef struct copier {
     const char *folder, *work;
+    char *const *library;      /* POV-Ray's library folders, NULL-terminated */
     seen *seen;
     int seen_count, seen_cap;
     scene_copy *out;
@@ -138,22 +139,25 @@ static int copy_of(copier *c, const char *path, int depth)
 
 /* The file an #include of name (len bytes) reads, into path, as POV-Ray 3.7 looks for it
    (SceneData::FindFile): a name ending in ".inc" or ".INC" as it is, then with ".inc" and
-   ".INC" appended, then any other name as it is; relative names in folder. */
-static bool find_include(const char *folder, const char *name, size_t len, char *path,
+   ".INC" appended, then any other name as it is; each relative one in the scene's folder,
+   then in each library folder. */
+static bool find_include(const copier *c, const char *name, size_t len, char *path,
                          size_t size)
 {
     const bool standard = len > 4 && (!memcmp(name + len - 4, ".inc", 4) ||
                                       !memcmp(name + len - 4, ".INC", 4));
     const char *const suffixes[] = {standard ? "" : ".inc", standard ? ".inc" : ".INC",
                                     standard ? ".INC" : ""};
-    for (int k = 0; k < 3; k++) {
-        if (name[0] == '/' || !strcmp(folder, "."))
-            snprintf(path, size, "%.*s%s", (int)len, name, suffixes[k]);
-        else
-            snprintf(path, size, "%s/%.*s%s", folder, (int)len, name, suffixes[k]);
-        if (access(path, F_OK) == 0)
-            return true;
-    }
+    for (int k = 0; k < 3; k++)
+        for (int d = -1; d < 0 || (name[0] != '/' && c->library[d]); d++) {
+            const char *dir = d < 0 ? c->folder : c->library[d];
+            if (name[0] == '/' || (d < 0 && !strcmp(dir, ".")))
+                snprintf(path, size, "%.*s%s", (int)len, name, suffixes[k]);
+            else
+                snprintf(path, size, "%s/%.*s%s", dir, (int)len, name, suffixes[k]);
+            if (access(path, F_OK) == 0)
+                return true;
+        }
     return false;
 }
 
@@ -165,7 +169,7 @@ static bool collect(const char *name, size_t len, int line, void *ctx)
     if (len == 0 || len >= NAME_MAX_BYTES || s->depth >= MAX_DEPTH)
         return true;
     char path[4096 + NAME_MAX_BYTES + 8];
-    const int file = find_include(c->folder, name, len, path, sizeof path)
+    const int file = find_include(c, name, len, path, sizeof path)
                          ? copy_of(c, path, s->depth + 1) : 0;
     if (file > 0 && s->count == s->cap) {
         swap *grown = realloc(s->swap, (size_t)(s->cap = 2 * s->cap + 8) * sizeof *grown);
@@ -225,7 +229,7 @@ static char *copy_text(copier *c, const char *path, const char *text, size_t n, 
 }
 
 int scene_copy_make(const char *scene, const char *text, size_t n, const char *work,
-                    scene_copy *out, l2p_error *err)
+                    char *const *library, scene_copy *out, l2p_error *err)
 {
     memset(out, 0, sizeof *out);
     char folder[4096];
@@ -235,7 +239,7 @@ int scene_copy_make(const char *scene, const char *text, size_t n, const char *w
         *slash = '\0';
     else
         snprintf(folder, sizeof folder, ".");
-    copier c = {folder, work, NULL, 0, 0, out, err, L2P_OK};
+    copier c = {folder, work, library, NULL, 0, 0, out, err, L2P_OK};
     int file = add_file(&c, scene);
     if (file == 0)
         out->text = copy_text(&c, scene, text, n, 0, &file);

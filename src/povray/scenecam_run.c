@@ -369,8 +369,11 @@ static int probe(const char *scene, const char *dir, const char *work, int w, in
         free(text);
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "not a text file");
     }
+    char **library = povargs_library_paths(dir, pa->user, pa->user_count);
     scene_copy sc;
-    int st = scene_copy_make(scene, text, n, work, &sc, err);
+    int st = library ? scene_copy_make(scene, text, n, work, library, &sc, err)
+                     : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    povargs_free(library);
     if (st) {
         free(text);
         return st;
