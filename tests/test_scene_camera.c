@@ -122,7 +122,8 @@ Test(scene_camera, conditionals_inside_the_camera_block)
 {
     expect_markers_as_povray(MARKERS_HEAD
                              "#declare Quality = 2;\n"
-                             "camera {\n  location <5, 5, 5>\n"
+                             "camera {\n  #if (image_width < 10) orthographic #end\n"
+                             "  location <5, 5, 5>\n"
                              "#if (image_width > 10) location Lift(Eye) #else location 9 #end\n"
                              "  look_at Target\n#ifdef (Undeclared) angle 80 #end\n"
                              "#switch (Quality)\n#case (1) angle 80 #break\n"
@@ -131,19 +132,27 @@ Test(scene_camera, conditionals_inside_the_camera_block)
                              "  right x * image_width / image_height\n}\n");
 }
 
-/* Any other directive inside the block, or a word that is no camera item, is refused naming
-   the statement's line (exit 2); a word in a branch that does not run is not read, as POV-Ray
-   does not read it. */
+/* Any other directive inside the block, a conditional that does not stand between items (in
+   an expression, or before a word that is no item), a type chosen by a conditional that runs,
+   or a word that is no camera item is refused naming the statement's line (exit 2); a type in
+   a branch that does not run is not read. POV-Ray's error in a block written over several
+   lines names the line it is on. */
 Test(scene_camera, other_directives_and_unknown_words_are_refused)
 {
     const char *dir = test_tmpdir();
     static const struct {
         const char *camera, *why;
-        int status;
+        int status, line;
     } cases[] = {
-        {"camera { location <0, 1, -4>\n  #declare A = 1; look_at 0 }\n", "#warning", 2},
-        {"camera { location <0, 1, -4>\n  #if (1) bogus 3 #end look_at 0 }\n", "not a camera", 2},
-        {"camera { location <0, 1, -4>\n  #if (0) bogus 3 #end look_at 0 }\n", NULL, 0},
+        {"camera { location <0, 1, -4>\n  #declare A = 1; look_at 0 }\n", "#warning", 2, 1},
+        {"camera { 3 location <0, 1, -4>\n  look_at 0 }\n", "not a camera", 2, 1},
+        {"camera { location <0, 1, -4>\n  #if (0) bogus 3 #end look_at 0 }\n", "between", 2, 1},
+        {"camera { location <0, 1, -4> angle #if (1) 40 #else 50 #end }\n", "between", 2, 1},
+        {"camera { location <0, #if (1) 1 #else 2 #end, -4> }\n", "between", 2, 1},
+        {"camera { location <0, 1, -4> #if (1) orthographic #end }\n", "conditional", 2, 1},
+        {"camera { location <0, 1, -4> #if (0) orthographic #end look_at 0 }\n", NULL, 0, 0},
+        {"\ncamera\n{\n  #if (1)\n    angle 40\n  #else\n    angle 50\n  #end\n"
+         "  look_at Undeclared\n}\n", "Undeclared", 1, 9},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         char scene[512], out[512], where[600];
@@ -153,7 +162,7 @@ Test(scene_camera, other_directives_and_unknown_words_are_refused)
         char *errtext = NULL;
         const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q",
                            "-o", out);
-        snprintf(where, sizeof where, "lens2pov: %s:1: ", scene);
+        snprintf(where, sizeof where, "lens2pov: %s:%d: ", scene, cases[k].line);
         cr_expect_eq(st, cases[k].status, "case %zu: %s", k, errtext ? errtext : "");
         if (cases[k].why)
             cr_expect(errtext && !strncmp(errtext, where, strlen(where)) &&

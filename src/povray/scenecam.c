@@ -41,7 +41,7 @@ typedef struct pov_camera {
     char type[32];
     vec3 location, direction, up, right, sky, look_at, focus;
     double angle;
-    bool has_look_at, has_angle, declared, unsupported, directive;
+    bool has_look_at, has_angle, declared, unsupported, directive, branch_type;
     affine trans, pending;     /* the transforms so far; the one being read */
     double version;
 } pov_camera;
@@ -153,6 +153,8 @@ static bool take_item(pov_camera *c, const char *msg, const char *scene, int lin
         return c->declared = true;
     if (!strcmp(word, "directive"))
         return c->unsupported = c->directive = true;
+    if (!strcmp(word, "branch_type"))
+        return c->unsupported = c->branch_type = true;
     if (!strcmp(word, "unknown"))
         return c->unsupported = true;
     if (!strcmp(word, "angle")) {
@@ -236,7 +238,9 @@ static int to_scene_camera(const pov_camera *c, const char *scene, int line, sce
     if (c->directive)
         return refuse(err, scene, line, "the camera block holds a directive other than #if, "
                       "#ifdef, #ifndef, #elseif, #else, #switch, #case, #range, #break, #end, "
-                      "#debug and #warning");
+                      "#debug and #warning, or one that does not stand between its items");
+    if (c->branch_type)
+        return refuse(err, scene, line, "the camera's type is chosen by a conditional directive");
     if (c->unsupported)
         return refuse(err, scene, line,
                       "the camera block holds a word that is not a camera item");

@@ -12,7 +12,9 @@
 #include <string.h>
 #include <unistd.h>
 
-enum { MAX_DEPTH = 8, NAME_MAX_BYTES = 1024 };
+/* MAX_READS bounds the work a web of includes that include each other can make (results
+   that reach an open file are not kept, so such a file may be read again). */
+enum { MAX_DEPTH = 8, MAX_READS = 2000, NAME_MAX_BYTES = 1024 };
 
 typedef struct seen {
     char *path;
@@ -24,7 +26,8 @@ typedef struct copier {
     const char *folder, *work;
     char *const *library;      /* POV-Ray's library folders, NULL-terminated */
     seen *seen;
-    int seen_count, seen_cap;
+    int seen_count, seen_cap, reads;
+    bool partial;              /* the file being read reached an open file or MAX_DEPTH */
     scene_copy *out;
     l2p_error *err;
     int status;
@@ -43,7 +46,9 @@ typedef struct swaps {
     copier *c;
 } swaps;
 
-static char *read_text(const char *path, size_t *n)
+/* The file's text; NULL when it cannot be read or is not text (POV-Ray will say what it
+   makes of it), with *oom set when memory ran out. */
+static char *read_text(const char *path, size_t *n, bool *oom)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
@@ -51,19 +56,20 @@ static char *read_text(const char *path, size_t *n)
     char *s = NULL;
     size_t cap = 0;
     *n = 0;
-    for (size_t got = 1; got > 0;) {
+    for (size_t got = 1; got > 0 && !*oom;) {
         if (*n + 4096 + 1 > cap) {
             char *grown = realloc(s, cap = 2 * cap + 8192);
-            if (!grown)
+            *oom = !grown;
+            s = grown ? grown : (free(s), NULL);
+            if (!s)
                 break;
-            s = grown;
         }
         *n += got = fread(s + *n, 1, 4096, f);
     }
     fclose(f);
     if (s)
         s[*n] = '\0';
-    if (s && memchr(s, '\0', *n)) {   /* not text: POV-Ray will say what it makes of it */
+    if (s && memchr(s, '\0', *n)) {
         free(s);
         return NULL;
     }
@@ -100,8 +106,14 @@ static char *copy_text(copier *c, const char *path, const char *text, size_t n, 
 static int copy_of(copier *c, const char *path, int depth)
 {
     for (int i = 0; i < c->seen_count; i++)
-        if (!strcmp(c->seen[i].path, path))
+        if (!strcmp(c->seen[i].path, path)) {
+            c->partial = c->partial || c->seen[i].open;
             return c->seen[i].open ? 0 : c->seen[i].file;
+        }
+    if (++c->reads > MAX_READS) {
+        c->partial = true;
+        return 0;
+    }
     if (c->seen_count == c->seen_cap) {
         seen *grown = realloc(c->seen, (size_t)(c->seen_cap = 2 * c->seen_cap + 8) * sizeof *grown);
         if (!grown)
@@ -115,7 +127,14 @@ static int copy_of(copier *c, const char *path, int depth)
     c->seen[at].open = true;
     c->seen_count++;
     size_t n;
-    char *text = read_text(path, &n);   /* unreadable: a library include, or POV-Ray's error */
+    bool oom = false;
+    char *text = read_text(path, &n, &oom);
+    if (oom)
+        out_of_memory(c);
+    /* A result reached through a file still open (an #include cycle) or cut at MAX_DEPTH may
+       miss a camera: it is not kept for a later #include of the same file. */
+    const bool was_partial = c->partial;
+    c->partial = false;
     int file = -1;
     char *copy = text ? copy_text(c, path, text, n, depth, &file) : NULL;
     free(text);
@@ -127,14 +146,20 @@ static int copy_of(copier *c, const char *path, int depth)
         if ((f && fclose(f) != 0) || !ok) {
             c->status = l2p_fail(c->err, L2P_FAILED, name, 0, "cannot write: %s", strerror(errno));
             unlink(name);
-        } else if (!(c->out->copy[file] = strdup(name)))
+        } else if (!(c->out->copy[file] = strdup(name))) {
             out_of_memory(c);
-        else
+            unlink(name);
+        } else {
             c->seen[at].file = file;
+        }
     }
     free(copy);
     c->seen[at].open = false;
-    return c->seen[at].file;
+    const int result = c->seen[at].file;
+    if (c->partial)
+        c->seen[at].path[0] = '\0';   /* forgotten: found again by no name */
+    c->partial = was_partial || c->partial;
+    return result;
 }
 
 /* The file an #include of name (len bytes) reads, into path, as POV-Ray 3.7 looks for it
@@ -166,8 +191,12 @@ static bool collect(const char *name, size_t len, int line, void *ctx)
     (void)line;
     swaps *s = ctx;
     copier *c = s->c;
-    if (len == 0 || len >= NAME_MAX_BYTES || s->depth >= MAX_DEPTH)
+    if (len == 0 || len >= NAME_MAX_BYTES)
         return true;
+    if (s->depth >= MAX_DEPTH) {
+        c->partial = true;
+        return true;
+    }
     char path[4096 + NAME_MAX_BYTES + 8];
     const int file = find_include(c, name, len, path, sizeof path)
                          ? copy_of(c, path, s->depth + 1) : 0;
@@ -239,7 +268,7 @@ int scene_copy_make(const char *scene, const char *text, size_t n, const char *w
         *slash = '\0';
     else
         snprintf(folder, sizeof folder, ".");
-    copier c = {folder, work, library, NULL, 0, 0, out, err, L2P_OK};
+    copier c = {folder, work, library, NULL, 0, 0, 0, false, out, err, L2P_OK};
     int file = add_file(&c, scene);
     if (file == 0)
         out->text = copy_text(&c, scene, text, n, 0, &file);

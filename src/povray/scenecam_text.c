@@ -287,16 +287,59 @@ static size_t directive_end(const char *s, size_t close, size_t a)
     return a;
 }
 
-/* Whether every directive in the camera block s(open, close) is one directive_end passes. */
+/* Whether the token s[a, b) can end an item: a type, or the last token of an expression (not
+   an item's keyword, an operator or an opening bracket). */
+static bool ends_item(const char *s, size_t a, size_t b)
+{
+    const enum item_kind kind = item_kind(s, a, b);
+    return kind == ITEM_TYPE || (kind == ITEM_NONE && !strchr("+-*/,(<=&|?:!", s[a]));
+}
+
+/* Whether every directive in the camera block s(open, close) is one directive_end passes and
+   stands between items: outside brackets and vectors, after a token that can end an item, and
+   followed by an item's keyword, another directive or the block's end. A directive inside an
+   item's expression would cut it, and a branch that starts with another word would leave its
+   items unread. */
 static bool directives_pass(const char *s, size_t open, size_t close)
 {
+    int parens = 0, angles = 0;
+    size_t prev_a = 0, prev_b = 0;   /* the last token that is not a directive */
     for (size_t i = skip_blank(s, close, open + 1); i < close;) {
-        const size_t e = s[i] == '#' ? directive_end(s, close, i) : token_end(s, close, i);
-        if (e == i)
+        if (s[i] != '#') {
+            const size_t e = token_end(s, close, i);
+            parens += (s[i] == '(') - (s[i] == ')');
+            angles += parens == 0 ? (s[i] == '<') - (s[i] == '>') : 0;
+            prev_a = i, prev_b = e;
+            i = skip_blank(s, close, e);
+            continue;
+        }
+        const size_t e = directive_end(s, close, i), next = skip_blank(s, close, e);
+        if (e == i || parens || angles || (prev_b > prev_a && !ends_item(s, prev_a, prev_b)))
             return false;
-        i = skip_blank(s, close, e);
+        if (next < close && s[next] != '#' &&
+            item_kind(s, next, token_end(s, close, next)) == ITEM_NONE)
+            return false;
+        i = next;
     }
     return true;
+}
+
+/* Newlines after what t holds from mark on, so that it has as many as s[a, b): POV-Ray's
+   messages then give the lines of the scene. */
+static void keep_lines(text *t, size_t mark, const char *s, size_t a, size_t b)
+{
+    for (int k = count_lines(s, a, b) - count_lines(t->s ? t->s : "", mark, t->n); k > 0; k--)
+        puts_(t, "\n");
+}
+
+/* The nesting a conditional directive at s[a] opens (1), closes (-1) or leaves (0). */
+static int nesting(const char *s, size_t close, size_t a)
+{
+    const size_t w = skip_blank(s, close, a + 1), we = w < close ? token_end(s, close, w) : w;
+    if (is_word(s, w, we, "if") || is_word(s, w, we, "ifdef") || is_word(s, w, we, "ifndef") ||
+        is_word(s, w, we, "switch"))
+        return 1;
+    return is_word(s, w, we, "end") ? -1 : 0;
 }
 
 /* One camera statement: "camera" at s[kw], its body s[open + 1, close), of file number file
@@ -313,6 +356,7 @@ static void put_camera(text *t, const char *s, size_t kw, size_t open, size_t cl
              "str(version, 0, 3), \"|\\n\") ", index, line, file_number);
     puts_(t, head);
     size_t i = skip_blank(s, close, open + 1);
+    keep_lines(t, start, s, kw, i);
     bool perspective = true;
     if (!directives_pass(s, open, close)) {
         puts_(t, "#debug \"\\nlens2pov-directive|\\n\" ");
@@ -325,39 +369,40 @@ static void put_camera(text *t, const char *s, size_t kw, size_t open, size_t cl
             i = close;
         }
     }
-    bool items = true;   /* false past an unknown word: only directives are copied then */
+    bool items = true;   /* false past an unknown word, to the branch's end */
+    int depth = 0;       /* of the conditionals around */
     while (i < close) {
-        const size_t a = i, b = token_end(s, close, i);
+        const size_t a = i, b = token_end(s, close, i), mark = t->n;
         const enum item_kind kind = item_kind(s, a, b);
-        if (s[a] == '#') {   /* directives_pass has passed it */
-            i = directive_end(s, close, a);
+        if (s[a] == '#') {   /* between items: directives_pass has passed it */
+            i = skip_blank(s, close, directive_end(s, close, a));
             put_expression(t, s, a, i);
             puts_(t, " ");
-            i = skip_blank(s, close, i);
-            continue;
-        }
-        if (!items) {
-            i = skip_blank(s, close, b);
+            depth += nesting(s, close, a);
+            items = true;
             continue;
         }
         const size_t e = item_end(s, close, b);
-        if (kind == ITEM_NONE) {
-            puts_(t, "#debug \"\\nlens2pov-unknown|\\n\" ");
+        if (!items || kind == ITEM_NONE) {
+            if (items)
+                puts_(t, "#debug \"\\nlens2pov-unknown|\\n\" ");
             items = false;
             i = skip_blank(s, close, b);
-            continue;
+        } else if (kind == ITEM_TYPE && depth > 0) {
+            puts_(t, "#debug \"\\nlens2pov-branch_type|\\n\" ");
+            items = false;
+            i = e;
+        } else {
+            if (kind == ITEM_TYPE)
+                perspective = is_word(s, a, b, "perspective");
+            if (perspective || kind == ITEM_TYPE)
+                put_item(t, s, a, b, e, kind);
+            i = e;
         }
-        if (kind == ITEM_TYPE)
-            perspective = is_word(s, a, b, "perspective");
-        if (perspective || kind == ITEM_TYPE)
-            put_item(t, s, a, b, e, kind);
-        i = e;
+        keep_lines(t, mark, s, a, i);
     }
     puts_(t, "#debug \"\\nlens2pov-end|\\n\"");
-    /* The statement's lines, less those the expressions kept. */
-    int missing = count_lines(s, kw, close + 1) - count_lines(t->s ? t->s : "", start, t->n);
-    for (; missing > 0; missing--)
-        puts_(t, "\n");
+    keep_lines(t, start, s, kw, close + 1);   /* the statement's lines, to its '}' */
 }
 
 /* ---------------------------------------------------------------- walking the scene */
