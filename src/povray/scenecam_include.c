@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "base/readfile.h"
 
 /* MAX_READS bounds the work a web of includes that include each other can make (results
    that reach an open file are not kept, so such a file may be read again). */
@@ -45,36 +46,6 @@ typedef struct swaps {
     int count, cap, depth;
     copier *c;
 } swaps;
-
-/* The file's text; NULL when it cannot be read or is not text (POV-Ray will say what it
-   makes of it), with *oom set when memory ran out. */
-static char *read_text(const char *path, size_t *n, bool *oom)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    char *s = NULL;
-    size_t cap = 0;
-    *n = 0;
-    for (size_t got = 1; got > 0 && !*oom;) {
-        if (*n + 4096 + 1 > cap) {
-            char *grown = realloc(s, cap = 2 * cap + 8192);
-            *oom = !grown;
-            s = grown ? grown : (free(s), NULL);
-            if (!s)
-                break;
-        }
-        *n += got = fread(s + *n, 1, 4096, f);
-    }
-    fclose(f);
-    if (s)
-        s[*n] = '\0';
-    if (s && memchr(s, '\0', *n)) {
-        free(s);
-        return NULL;
-    }
-    return s;
-}
 
 static int out_of_memory(copier *c)
 {
@@ -126,11 +97,14 @@ static int copy_of(copier *c, const char *path, int depth)
     c->seen[at].file = 0;
     c->seen[at].open = true;
     c->seen_count++;
-    size_t n;
-    bool oom = false;
-    char *text = read_text(path, &n, &oom);
-    if (oom)
+    size_t n = 0;
+    char *text = read_whole_file(path, &n);   /* unreadable: POV-Ray will say so */
+    if (!text && errno == ENOMEM)
         out_of_memory(c);
+    if (text && memchr(text, '\0', n)) {   /* not text: POV-Ray will say what it makes of it */
+        free(text);
+        text = NULL;
+    }
     /* A result reached through a file still open (an #include cycle) or cut at MAX_DEPTH may
        miss a camera: it is not kept for a later #include of the same file. */
     const bool was_partial = c->partial;

@@ -19,35 +19,13 @@
 #include <unistd.h>
 #include "base/cleanup.h"
 #include "base/outfile.h"
+#include "base/readfile.h"
 #include "base/tempdir.h"
 #include "povray/povargs.h"
 #include "povray/povray_env.h"
 #include "povray/povray_log.h"
 
 extern char **environ;
-
-/* The whole file, NUL-terminated (malloc'd); *n its length. */
-static char *read_all(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 1 << 16, len = 0;
-    char *buf = malloc(cap);
-    for (size_t got; buf && (got = fread(buf + len, 1, cap - len, f)) > 0;) {
-        len += got;
-        char *grown = len == cap ? realloc(buf, cap *= 2) : buf;
-        if (!grown)
-            free(buf);
-        buf = grown;
-    }
-    fclose(f);
-    if (buf) {   /* len < cap: the loop grows the buffer when it is full */
-        buf[len] = '\0';
-        *n = len;
-    }
-    return buf;
-}
 
 static int write_all(const char *path, const char *s, l2p_error *err)
 {
@@ -269,7 +247,7 @@ static bool refused_options(const char *log, const probe_args *pa, l2p_error *er
 {
     static const char problem[] = "Problem with option setting";
     size_t n = 0;
-    char *text = read_all(log, &n);
+    char *text = read_whole_file(log, &n);
     bool refused = false;
     for (size_t i = 0; text && !refused && i + sizeof problem - 1 <= n; i++)
         refused = !memcmp(text + i, problem, sizeof problem - 1);
@@ -345,7 +323,7 @@ static int run_copy(const char *scene, const char *dir, const char *work, int w,
         }
     }
     size_t n = 0;
-    char *out_log = st ? NULL : read_all(log, &n);
+    char *out_log = st ? NULL : read_whole_file(log, &n);
     if (!st && !out_log)
         st = l2p_fail(err, L2P_FAILED, log, 0, "cannot read: %s", strerror(errno));
     const scene_files files = {(const char *const *)sc->path, sc->count};
@@ -362,7 +340,7 @@ static int probe(const char *scene, const char *dir, const char *work, int w, in
                  const probe_args *pa, scene_frames *out, l2p_error *err)
 {
     size_t n = 0;
-    char *text = read_all(scene, &n);
+    char *text = read_whole_file(scene, &n);
     if (!text)
         return l2p_fail(err, L2P_BAD_INPUT, scene, 0, "cannot read: %s", strerror(errno));
     if (memchr(text, '\0', n)) {
