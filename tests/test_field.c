@@ -164,6 +164,38 @@ Test(field, fisheye_every_pixel_within_the_tolerance)
     cr_expect(st.blocked > 0, "the fisheye's image circle blocks the corners");
 }
 
+/* Where only the image circle's rim limits the faces (a tolerance no lens needs here), the rim
+   is drawn by long faces along it: fewer faces than rim pixels (passing pixels with a blocked
+   neighbour). Split down to single pixels, it took three to four faces a rim pixel. */
+Test(field, the_image_circles_rim_takes_fewer_faces_than_its_pixels)
+{
+    camera_options o = small(160, 120);
+    camera c;
+    test_camera(&c, "fisheye.10mm", &o);
+    for (uint32_t k = 0; k < 2; k++) {
+        field_stats st;
+        check_subimage("fisheye.10mm", &o, 20, k, &st);
+        const film_sample s = sobol_shared_sample(o.seed, k);
+        bool pass[120][160];
+        for (int y = 0; y < 120; y++)
+            for (int x = 0; x < 160; x++) {
+                vec3 fp = film_camera_from_raster(&c.film, x + s.offset_x, y + s.offset_y);
+                ray r;
+                double weight;
+                pass[y][x] = pupil_reaches(&c.pupil, fp) && camera_trace(&c, fp, s.pupil_u, s.pupil_v, &r, &weight);
+            }
+        int rim = 0;
+        for (int y = 0; y < 120; y++)
+            for (int x = 0; x < 160; x++)
+                rim += pass[y][x] && ((x > 0 && !pass[y][x - 1]) || (x < 159 && !pass[y][x + 1]) ||
+                                      (y > 0 && !pass[y - 1][x]) || (y < 119 && !pass[y + 1][x]));
+        cr_log_info("fisheye sample %u: %d rim pixels, %d faces", k, rim, st.faces);
+        cr_expect(rim > 100, "the image circle lies inside the film");
+        cr_expect(st.faces < rim, "%d faces for %d rim pixels", st.faces, rim);
+    }
+    camera_free(&c);
+}
+
 Test(field, a_crop_every_pixel_within_the_tolerance)
 {
     camera_options o = small(320, 240);

@@ -89,19 +89,23 @@ static void *build_worker(void *arg)
     return NULL;
 }
 
-static int build_all(job *j, int threads, l2p_error *err)
+/* worker(arg) on up to threads threads (at most 64), or on this one when none starts. */
+static void run_workers(void *(*worker)(void *), void *arg, int threads)
 {
     pthread_t t[64];
     int started = 0;
-    if (threads > 64)
-        threads = 64;
-    for (int i = 0; i < threads; i++)
-        if (pthread_create(&t[started], NULL, build_worker, j) == 0)
+    for (int i = 0; i < threads && i < 64; i++)
+        if (pthread_create(&t[started], NULL, worker, arg) == 0)
             started++;
     if (started == 0)
-        build_worker(j);
+        worker(arg);
     for (int i = 0; i < started; i++)
         pthread_join(t[i], NULL);
+}
+
+static int build_all(job *j, int threads, l2p_error *err)
+{
+    run_workers(build_worker, j, threads);
     if (atomic_load(&j->status))
         *err = j->err;
     return atomic_load(&j->status);
@@ -254,6 +258,52 @@ static int write_include(const camera *c, const sub *subs, const field_render_pl
     return st ? st : outfile_finish(f, err);
 }
 
+/* The includes, written on worker threads (their files opened beforehand: the table of
+   temporary files to remove on a signal is the main thread's). */
+typedef struct writing {
+    const camera *c;
+    const sub *subs;
+    const field_render_plan *plans;
+    const char *placement;
+    outfile *inc;
+    int renders;
+    atomic_int next;
+    atomic_int status;
+    l2p_error err;
+    pthread_mutex_t lock;
+} writing;
+
+static void *write_worker(void *arg)
+{
+    writing *w = arg;
+    for (int r; atomic_load(&w->status) == L2P_OK && (r = atomic_fetch_add(&w->next, 1)) < w->renders;) {
+        l2p_error e;
+        const int st = write_include(w->c, w->subs, &w->plans[r], w->placement, &w->inc[r], &e);
+        if (st) {
+            pthread_mutex_lock(&w->lock);
+            if (atomic_load(&w->status) == L2P_OK) {
+                w->err = e;
+                atomic_store(&w->status, st);
+            }
+            pthread_mutex_unlock(&w->lock);
+        }
+    }
+    return NULL;
+}
+
+static int write_includes(writing *w, int threads, l2p_error *err)
+{
+    atomic_init(&w->next, 0);
+    atomic_init(&w->status, L2P_OK);
+    pthread_mutex_init(&w->lock, NULL);
+    run_workers(write_worker, w, threads < w->renders ? threads : w->renders);
+    pthread_mutex_destroy(&w->lock);
+    const int st = atomic_load(&w->status);
+    if (st)
+        *err = w->err;
+    return st;
+}
+
 /* Its ini: (W+1) x (H+1) pixels, rows 2.. and columns ..W only (FS#261, docs/povray.md), and
    of those only the grid's (POV-Ray still searches the faces for a pixel no face covers, at
    about the cost of a pixel that one does), the picture named by its absolute path. */
@@ -393,10 +443,15 @@ static int build_files(const camera *c, const field_files_request *q, field_file
                              .output_exr = name_of(prefix, r, "exr"), .faces = plans[r].faces};
         if (!ch->include_path || !ch->ini_path || !ch->output_exr)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-        if (!st && !(st = outfile_open(&out->inc[r], ch->include_path, err)))
-            st = write_include(c, subs, &plans[r], q->placement, &out->inc[r], err);
+        if (!st)
+            st = outfile_open(&out->inc[r], ch->include_path, err);
         if (!st && !(st = outfile_open(&out->ini[r], ch->ini_path, err)))
             st = write_ini(&plans[r], ch->output_exr, &out->ini[r], err);
+    }
+    if (!st) {
+        writing w = {.c = c, .subs = subs, .plans = plans, .placement = q->placement,
+                     .inc = out->inc, .renders = renders};
+        st = write_includes(&w, jobs, err);
     }
     out->plans = plans;
     return st;

@@ -1,9 +1,10 @@
 /* The adaptive mesh of one sub-image. Every pixel's exact ray is traced (the guarantee is
    checked at every pixel, so nothing less would do); cells whose corners are pixels are
-   refined until, at every pixel a cell's two faces contain, the model of POV-Ray's ray
-   (povuv.c) is within the tolerance of the exact one (a passing cell halved across its longer
-   side, a cell the lens partly blocks split in four), or until they reach single pixels where
-   the lens blocks some corners. Pixels no face took get a tiny face of their own. */
+   refined until, at every pixel a cell's faces contain, the model of POV-Ray's ray (povuv.c)
+   is within the tolerance of the exact one: a passing cell as two faces along either diagonal,
+   else halved across its longer side; a cell the lens partly blocks as the convex hull of its
+   passing pixels, else split in four, down to single pixels. Pixels no face took get a tiny
+   face of their own (docs/fields.md, "The mesh of a sub-image"). */
 #include "field/subimage.h"
 
 #include <stdlib.h>
@@ -172,8 +173,15 @@ static bool pixel_ok(const builder *b, const povuv_face *f, int x, int y, double
     return e <= 1.0;
 }
 
-static bool face_ok(const builder *b, const povuv_face *f, int x0, int y0, int x1, int y1, double *worst)
+/* Whether every pixel of [x0, x1] x [y0, y1] is fine with face f, whose corners are the
+   pixels px. The pixel nearest the face's centroid goes first: the error of interpolating a
+   smooth field peaks inside a face, so a face that fails mostly fails there, at once. */
+static bool face_ok(const builder *b, const povuv_face *f, const int px[3][2], int x0, int y0, int x1,
+                    int y1, double *worst)
 {
+    const int cx = (px[0][0] + px[1][0] + px[2][0] + 1) / 3, cy = (px[0][1] + px[1][1] + px[2][1] + 1) / 3;
+    if (!pixel_ok(b, f, cx, cy, worst))
+        return false;
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++)
             if (!pixel_ok(b, f, x, y, worst))
@@ -208,31 +216,41 @@ static void emit(builder *b, const int px[3][2], double worst)
 
 /* ---------------------------------------------------------------- the cells */
 
-/* A cell's two faces split along the diagonal from its top-right to its bottom-left corner. */
-static void cell_faces(int x0, int y0, int x1, int y1, int t[2][3][2])
+/* A cell's two faces, split along the diagonal from its top-right to its bottom-left corner
+   (diagonal 0) or from its top-left to its bottom-right corner (diagonal 1). */
+static void cell_faces(int x0, int y0, int x1, int y1, int diagonal, int t[2][3][2])
 {
-    int a[2] = {x0, y0}, bb[2] = {x1, y0}, c[2] = {x0, y1}, d[2] = {x1, y1};
-    memcpy(t[0][0], a, sizeof a), memcpy(t[0][1], bb, sizeof bb), memcpy(t[0][2], c, sizeof c);
-    memcpy(t[1][0], bb, sizeof bb), memcpy(t[1][1], d, sizeof d), memcpy(t[1][2], c, sizeof c);
+    const int corner[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    static const int of[2][2][3] = {{{0, 1, 3}, {1, 2, 3}}, {{0, 1, 2}, {0, 2, 3}}};
+    for (int k = 0; k < 2; k++)
+        for (int j = 0; j < 3; j++)
+            memcpy(t[k][j], corner[of[diagonal][k][j]], sizeof t[k][j]);
 }
 
-/* A whole passing cell: both faces, if every pixel they contain is within the tolerance. */
+/* A whole passing cell: both faces, if every pixel they contain is within the tolerance, along
+   either diagonal. Which diagonal keeps the error smaller depends on the direction in which
+   the field bends most, mostly radial with a lens's distortion, so both are tried. */
 static bool try_cell(builder *b, int x0, int y0, int x1, int y1)
 {
-    int t[2][3][2];
-    povuv_face f[2];
-    double worst = 0;
-    cell_faces(x0, y0, x1, y1, t);
-    for (int k = 0; k < 2; k++) {
-        pixel_face(b, (const int(*)[2])t[k], &f[k]);
-        if (!face_ok(b, &f[k], x0, y0, x1, y1, &worst))
-            return false;
+    for (int diagonal = 0; diagonal < 2; diagonal++) {
+        int t[2][3][2];
+        povuv_face f[2];
+        double worst = 0;
+        bool ok = true;
+        cell_faces(x0, y0, x1, y1, diagonal, t);
+        for (int k = 0; k < 2 && ok; k++) {
+            pixel_face(b, (const int(*)[2])t[k], &f[k]);
+            ok = face_ok(b, &f[k], (const int(*)[2])t[k], x0, y0, x1, y1, &worst);
+        }
+        if (!ok)
+            continue;
+        for (int k = 0; k < 2; k++)
+            emit(b, (const int(*)[2])t[k], worst);
+        for (int y = y0; y <= y1; y++)
+            memset(b->covered + (size_t)y * b->w + x0, 1, (size_t)(x1 - x0 + 1));
+        return true;
     }
-    for (int k = 0; k < 2; k++)
-        emit(b, (const int(*)[2])t[k], worst);
-    for (int y = y0; y <= y1; y++)
-        memset(b->covered + (size_t)y * b->w + x0, 1, (size_t)(x1 - x0 + 1));
-    return true;
+    return false;
 }
 
 /* A cell one pixel wide and high: each face of three passing corners whose pixels (its
@@ -255,9 +273,83 @@ static void finest(builder *b, int x0, int y0, int x1, int y1)
         if (!all || !new_pixel)
             continue;
         pixel_face(b, (const int(*)[2])t, &f);
-        if (face_ok(b, &f, x0, y0, x1, y1, &worst))
+        if (face_ok(b, &f, (const int(*)[2])t, x0, y0, x1, y1, &worst))
             emit(b, (const int(*)[2])t, worst);
     }
+}
+
+/* A cell the lens partly blocks: the convex hull of its passing pixels (each row's first and
+   last), as a fan of faces from its first corner. Where the passing region is convex, as the
+   intersection of the stop's and the rims' images is, the hull holds no blocked pixel, and a
+   few long faces follow an edge that single pixels would take two faces each to draw. Taken
+   when every face keeps the tolerance and holds no blocked pixel, as every face must. */
+enum { HULL_MOST = 2 * (FIELD_BASE_CELL + 1) };
+
+static int hull_of(const builder *b, int x0, int y0, int x1, int y1, int hull[][2])
+{
+    int pts[HULL_MOST][2], n = 0, m = 0;
+    for (int y = y0; y <= y1; y++) {
+        const unsigned char *row = b->passed + (size_t)y * b->w;
+        int first = x0, last = x1;
+        while (first <= x1 && !row[first])
+            first++;
+        while (last > first && !row[last])
+            last--;
+        if (first > x1)
+            continue;
+        pts[n][0] = first, pts[n++][1] = y;
+        if (last > first)
+            pts[n][0] = last, pts[n++][1] = y;
+    }
+    /* Andrew's monotone chain over points sorted by (y, x), collinear points dropped */
+    for (int pass = 0; pass < 2; pass++) {
+        const int start = m;
+        for (int k = 0; k < n; k++) {
+            const int *q = pts[pass ? n - 1 - k : k];
+            while (m >= start + 2 &&
+                   (long)(hull[m - 1][0] - hull[m - 2][0]) * (q[1] - hull[m - 2][1]) -
+                   (long)(hull[m - 1][1] - hull[m - 2][1]) * (q[0] - hull[m - 2][0]) <= 0)
+                m--;
+            hull[m][0] = q[0], hull[m++][1] = q[1];
+        }
+        m--;   /* each chain's last point starts the other */
+    }
+    return m;
+}
+
+static bool try_hull(builder *b, int x0, int y0, int x1, int y1)
+{
+    int hull[2 * HULL_MOST][2];
+    if (x1 - x0 > FIELD_BASE_CELL || y1 - y0 > FIELD_BASE_CELL)
+        return false;
+    const int n = hull_of(b, x0, y0, x1, y1, hull);
+    if (n < 3)
+        return false;
+    povuv_face f[2 * HULL_MOST];
+    double worst = 0;
+    for (int k = 1; k + 1 < n; k++) {
+        const int t[3][2] = {{hull[0][0], hull[0][1]}, {hull[k][0], hull[k][1]},
+                             {hull[k + 1][0], hull[k + 1][1]}};
+        pixel_face(b, t, &f[k]);
+        if (!face_ok(b, &f[k], t, x0, y0, x1, y1, &worst))
+            return false;
+    }
+    for (int k = 1; k + 1 < n; k++) {
+        const int t[3][2] = {{hull[0][0], hull[0][1]}, {hull[k][0], hull[k][1]},
+                             {hull[k + 1][0], hull[k + 1][1]}};
+        emit(b, t, worst);
+    }
+    /* the pixels the faces hold, as POV-Ray finds them */
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            double u, v, w[3];
+            povuv_pixel_uv(b->m->render_w, b->m->render_h, x, y, &u, &v);
+            for (int k = 1; k + 1 < n && !b->covered[y * b->w + x]; k++) {
+                povuv_face_weights(&f[k], u, v, w);
+                b->covered[y * b->w + x] = w[0] >= 0 && w[1] >= 0 && w[2] >= 0;
+            }
+        }
+    return true;
 }
 
 static void build_cell(builder *b, int x0, int y0, int x1, int y1)
@@ -268,6 +360,8 @@ static void build_cell(builder *b, int x0, int y0, int x1, int y1)
     if (pass == 0)
         return;
     if (pass == area && try_cell(b, x0, y0, x1, y1))
+        return;
+    if (pass < area && try_hull(b, x0, y0, x1, y1))
         return;
     bool sx = x1 - x0 >= 2, sy = y1 - y0 >= 2;
     if (!sx && !sy) {
