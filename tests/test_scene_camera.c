@@ -321,6 +321,55 @@ Test(scene_camera, wrapped_messages)
     cr_expect(fabs(sc.hfov_deg - 2.0 * atan(0.665) * 180.0 / M_PI) < 1e-9);
 }
 
+/* A focal point puts focal blur's plane at its distance from the location, measured before
+   the transforms, as POV-Ray's Parse_Camera does; it wins over look_at. */
+Test(scene_camera, the_focal_point_is_in_focus)
+{
+    const char *scene = "s.pov";
+    const scene_files files = {&scene, 1};
+    static const struct {
+        const char *items;
+        double focus;
+    } cases[] = {
+        /* new syntax: after look_at, before the transforms (the scale leaves it as it is) */
+        {"lens2pov-version 3.700|\n\nlens2pov-location 0 2 -3|\n\nlens2pov-focal_point 1 2 1|\n"
+         "\nlens2pov-look_at 0 2 0|\n\nlens2pov-t0 0 0 0|\n\nlens2pov-t1 2 0 0|\n"
+         "\nlens2pov-t2 0 2 0|\n\nlens2pov-t3 0 0 2|\n", 4.123105625617661},
+        /* old syntax: at the item, from the location then in effect */
+        {"lens2pov-version 3.100|\n\nlens2pov-location 0 0 -5|\n\nlens2pov-focal_point 0 0 0|\n"
+         "\nlens2pov-location 0 0 -6|\n", 5.0},
+        /* a focal point at the location: POV-Ray's 1 */
+        {"lens2pov-version 3.700|\n\nlens2pov-location 0 0 -5|\n\nlens2pov-focal_point 0 0 -5|\n"
+         "\nlens2pov-look_at 0 0 0|\n", 1.0},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        char log[1024];
+        snprintf(log, sizeof log, "\nlens2pov-camera 0 3|\n\n%s\nlens2pov-end|\n", cases[k].items);
+        scene_camera sc;
+        l2p_error err;
+        cr_assert_eq(scene_camera_from_log(log, strlen(log), &files, &sc, &err), 0, "%zu: %s", k, err.text);
+        cr_expect(fabs(sc.focus_distance - cases[k].focus) < 1e-12, "case %zu: focus %.17g, not %.17g",
+                  k, sc.focus_distance, cases[k].focus);
+    }
+}
+
+/* The focal point as POV-Ray evaluates it in a scene: an expression of declared vectors. */
+Test(scene_camera, the_scenes_focal_point_is_evaluated)
+{
+    const char *dir = test_tmpdir();
+    char scene[512];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    write_text(scene, MARKERS_HEAD "camera { location Lift(Eye) look_at Target angle 40\n"
+                                   "  aperture 0.2 blur_samples 4 focal_point Target + <1, 0, 2> }\n");
+    scene_camera sc;
+    l2p_error err;
+    cr_assert_eq(scene_camera_read(scene, 64, 48, &sc, &err), L2P_OK, "%s", err.text);
+    /* Lift(Eye) = <1, 2.5, -4>, the focal point <1.2, 0.5, 2> */
+    const double expected = sqrt(0.2 * 0.2 + 2.0 * 2.0 + 6.0 * 6.0);
+    cr_expect(fabs(sc.focus_distance - expected) < 1e-12, "focus %.17g, not %.17g", sc.focus_distance,
+              expected);
+}
+
 /* The probe is not waited for once the scene is parsed (what POV-Ray still does, a pixel and
    its winding down, takes about 0.4 s): a stand-in that notes its pid, runs POV-Ray and then
    writes "ended" is gone, without having written it, when scene_camera_read returns the

@@ -39,9 +39,9 @@ static affine affine_then(const affine *a, const affine *b)
 
 typedef struct pov_camera {
     char type[32];
-    vec3 location, direction, up, right, sky, look_at, focus;
-    double angle;
-    bool has_look_at, has_angle, declared, unsupported, directive, branch_type;
+    vec3 location, direction, up, right, sky, look_at, focus, focal_point;
+    double angle, focal_distance;
+    bool has_look_at, has_angle, has_focal_point, declared, unsupported, directive, branch_type;
     affine trans, pending;     /* the transforms so far; the one being read */
     double version;
 } pov_camera;
@@ -94,6 +94,16 @@ static int apply_look_at(pov_camera *c, const char *scene, int line, l2p_error *
     c->right = v3_scale(r, hand > 0.0 ? rl : -rl);
     c->focus = c->look_at;
     return L2P_OK;
+}
+
+/* Focal blur's plane: |focal_point - location| ahead along direction, measured before the
+   transforms and kept through them (Parse_Camera; TracePixel::JitterCameraRay scales the
+   unnormalized ray to that distance), 1 for a focal point at the location. */
+static void apply_focal_point(pov_camera *c)
+{
+    c->focal_distance = v3_length(v3_sub(c->focal_point, c->location));
+    if (c->focal_distance == 0.0)
+        c->focal_distance = 1.0;
 }
 
 /* ---------------------------------------------------------------- reading the #debug lines */
@@ -197,6 +207,11 @@ static bool take_item(pov_camera *c, const char *msg, const char *scene, int lin
         c->has_look_at = true;
         if (old)
             *st = apply_look_at(c, scene, line, err);
+    } else if (!strcmp(word, "focal_point")) {
+        c->focal_point = x;
+        c->has_focal_point = true;
+        if (old)
+            apply_focal_point(c);
     } else
         return false;
     return true;
@@ -217,6 +232,8 @@ static int finish_camera(pov_camera *c, const char *scene, int line, l2p_error *
         if (st)
             return st;
     }
+    if (c->has_focal_point)
+        apply_focal_point(c);
     apply_transform(c, &c->trans);
     return L2P_OK;
 }
@@ -262,8 +279,13 @@ static int to_scene_camera(const pov_camera *c, const char *scene, int line, sce
     /* up made exactly perpendicular to forward: lens2pov builds right from it */
     out->up = v3_normalize(v3_sub(u, v3_scale(d, v3_dot(u, d))));
     out->mirrored = v3_dot(v3_cross(u, d), r) < 0.0;
+    /* What the scene's author put in focus: focal blur's plane, else the look_at point, else
+       |direction| ahead (where POV-Ray's focal blur focuses then). */
     const double focus = v3_dot(v3_sub(c->focus, c->location), d);
-    out->focus_distance = c->has_look_at && focus > 0.0 && isfinite(focus) ? focus : dl;
+    if (c->has_focal_point && isfinite(c->focal_distance))
+        out->focus_distance = c->focal_distance;
+    else
+        out->focus_distance = c->has_look_at && focus > 0.0 && isfinite(focus) ? focus : dl;
     out->hfov_deg = 2.0 * atan(0.5 * rl / dl) * 180.0 / M_PI;
     out->found = true;
     out->line = line;

@@ -16,7 +16,8 @@ typedef struct scene_camera {
     vec3 location;
     vec3 forward, up;          /* unit, perpendicular */
     bool mirrored;             /* right points against up x direction: the picture is mirrored */
-    double focus_distance;     /* along forward to the look_at point (else |direction|) */
+    double focus_distance;     /* ahead to focal blur's plane (focal_point), else to the
+                                  look_at point, else |direction| */
     double hfov_deg;           /* horizontal angle: 2 atan(|right| / (2 |direction|)) */
     bool found;                /* false: no camera statement ran, POV-Ray's default camera */
     int line;                  /* the statement's line in its file (0 when not found) */

@@ -119,10 +119,11 @@ enum lex_item lex_item_kind(const char *s, size_t a, size_t b)
     static const char *const types[] = {"perspective", "orthographic", "fisheye",
                                         "ultra_wide_angle", "omnimax", "panoramic", "spherical",
                                         "cylinder", "mesh_camera", "user_defined"};
-    static const char *const vectors[] = {"location", "look_at", "direction", "up", "right", "sky"};
+    static const char *const vectors[] = {"location", "look_at", "direction", "up", "right", "sky",
+                                          "focal_point"};
     static const char *const transforms[] = {"translate", "rotate", "scale", "matrix", "transform"};
-    static const char *const ignored[] = {"focal_point", "aperture", "blur_samples", "confidence",
-                                          "variance", "normal", "bokeh"};
+    static const char *const ignored[] = {"aperture", "blur_samples", "confidence", "variance",
+                                          "normal", "bokeh"};
     for (size_t k = 0; k < sizeof types / sizeof *types; k++)
         if (lex_is_word(s, a, b, types[k]))
             return ITEM_TYPE;
