@@ -1,10 +1,10 @@
 /* The adaptive mesh of one sub-image. Every pixel's exact ray is traced (the guarantee is
    checked at every pixel, so nothing less would do); cells whose corners are pixels are
    refined until, at every pixel a cell's faces contain, the model of POV-Ray's ray (povuv.c)
-   is within the tolerance of the exact one: a passing cell as two faces along either diagonal,
-   else halved across its longer side; a cell the lens partly blocks as the convex hull of its
-   passing pixels, else split in four, down to single pixels. Pixels no face took get a tiny
-   face of their own (docs/fields.md, "The mesh of a sub-image"). */
+   is within the tolerance of the exact one: a passing cell as two faces along either
+   diagonal, else halved the way its halves err less; a cell the lens partly blocks as the
+   convex hull of its passing pixels, else split in four, down to single pixels. Pixels no
+   face took get a tiny face of their own (docs/fields.md, "The mesh of a sub-image"). */
 #include "field/subimage.h"
 
 #include <stdlib.h>
@@ -352,6 +352,33 @@ static bool try_hull(builder *b, int x0, int y0, int x1, int y1)
     return true;
 }
 
+/* The model's error, in tolerances, at the pixels nearest the centroids of a passing cell's two
+   faces (split along diagonal 0), where interpolating a smooth field errs most. */
+static double centroid_error(const builder *b, int x0, int y0, int x1, int y1)
+{
+    int t[2][3][2];
+    double worst = 0;
+    cell_faces(x0, y0, x1, y1, 0, t);
+    for (int k = 0; k < 2; k++) {
+        povuv_face f;
+        pixel_face(b, (const int(*)[2])t[k], &f);
+        pixel_ok(b, &f, (t[k][0][0] + t[k][1][0] + t[k][2][0] + 1) / 3,
+                 (t[k][0][1] + t[k][1][1] + t[k][2][1] + 1) / 3, &worst);
+    }
+    return worst;
+}
+
+/* Which way to halve a passing cell that failed: the halves whose faces err less at their
+   centroids. Where a lens's distortion bends the field most depends on its projection (across
+   the radius for a fisheye, along it for a rectilinear lens) and on the cell's place on the
+   film, so the two are compared rather than assumed. */
+static bool halve_along_x(const builder *b, int x0, int y0, int x1, int y1)
+{
+    const int mx = (x0 + x1) / 2, my = (y0 + y1) / 2;
+    return centroid_error(b, x0, y0, mx, y1) + centroid_error(b, mx, y0, x1, y1) <=
+           centroid_error(b, x0, y0, x1, my) + centroid_error(b, x0, my, x1, y1);
+}
+
 static void build_cell(builder *b, int x0, int y0, int x1, int y1)
 {
     if (b->oom || x1 <= x0 || y1 <= y0)
@@ -368,11 +395,11 @@ static void build_cell(builder *b, int x0, int y0, int x1, int y1)
         finest(b, x0, y0, x1, y1);
         return;
     }
-    /* A passing cell is halved across its longer side only: where the error grows faster one
-       way (distortion, mostly radial), the halves are often within the tolerance already, two
-       faces each where a split in four makes eight (docs/fields.md). */
+    /* A passing cell is halved, not split in four: where the error grows faster one way, the
+       halves are often within the tolerance already, two faces each where a split in four
+       makes eight (docs/fields.md). */
     if (pass == area) {
-        const bool along_x = sx && (x1 - x0 >= y1 - y0 || !sy);
+        const bool along_x = sx && (!sy || halve_along_x(b, x0, y0, x1, y1));
         const int mx = along_x ? (x0 + x1) / 2 : x1, my = along_x ? y1 : (y0 + y1) / 2;
         build_cell(b, x0, y0, mx, my);
         build_cell(b, along_x ? mx : x0, along_x ? y0 : my, x1, y1);
