@@ -39,7 +39,7 @@ typedef struct field_files_request {
     const char *placement;
     outfile *rays_csv;         /* --rays: written and finished, not committed; NULL: none */
     /* What a render costs POV-Ray beyond its pixels, as a frame of a run (seconds): what the
-       packing weighs against the face search (field_render.c, face_budget). */
+       packing weighs against the face search (field_render.c, cost_per_sub). */
     double frame_s;
 } field_files_request;
 

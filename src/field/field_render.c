@@ -120,20 +120,6 @@ static void grid_size(int n, int nx, int w, int h, int *rw, int *rh)
     *rh = field_render_size((n + nx - 1) / nx * h);
 }
 
-/* Faces a render takes. Each render is a frame of a POV-Ray run, with an overhead of about
-   frame_s; POV-Ray's face search costs a pixel about SEARCH_S a face of its render (it scans
-   the faces in order up to the first that holds the pixel; docs/povray.md). Renders of B faces,
-   of sub-images of f faces and p pixels each, cost (spp f / B) frame_s + spp p SEARCH_S B,
-   least at B = sqrt(frame_s f / (p SEARCH_S)); at most FIELD_FACES_PER_RENDER. */
-#define SEARCH_S 4e-11
-
-static long long face_budget(long long faces, int spp, int w, int h, double frame_s)
-{
-    const double f = fmax(1.0, (double)faces / spp);
-    const double b = sqrt(frame_s * f / ((double)w * h * SEARCH_S));
-    return (long long)fmax(1.0, fmin(b, FIELD_FACES_PER_RENDER));
-}
-
 /* How far a picture of w x h is from square: POV-Ray's grid cells are a tenth of each side,
    and a face is a candidate in every cell its UV box touches, so square cells are straddled by
    fewer faces. */
@@ -162,27 +148,46 @@ static int grid_of(int n, int w, int h)
     return best_nx;
 }
 
-/* How many renders: as many as a render's count allows, the largest that face_budget and an
-   equal share for every job take (of the first sub-images) and that has a grid; at least as
-   many as the budget needs on average; a multiple of the jobs, so that the jobs get equal
-   shares. */
+/* What a render of n sub-images (in a grid of nx columns) costs each of them, in seconds: the
+   frame's overhead, frame_s of POV-Ray's waiting, which the other jobs' work partly fills
+   (frame_s / jobs); its picture, written by POV-Ray and read back, PICTURE_S a pixel used or
+   not; and POV-Ray's face search, SEARCH_S a face of the render for each pixel (it scans the
+   faces in order up to the first that holds the pixel; docs/povray.md). More sub-images a
+   render share its overhead and pay more search. */
+#define SEARCH_S 4e-11
+#define PICTURE_S 4e-8
+
+static double cost_per_sub(int n, int nx, int w, int h, double faces_per_sub, int jobs,
+                           double frame_s)
+{
+    int rw, rh;
+    grid_size(n, nx, w, h, &rw, &rh);
+    const double picture = (rw + 1.0) * (rh + 1.0);
+    return (frame_s / jobs + picture * PICTURE_S) / n + (double)w * h * SEARCH_S * n * faces_per_sub;
+}
+
+/* How many renders: as many as the count of sub-images a render costs least with (of the
+   counts that have a grid, that an equal share for every job allows and whose first
+   sub-images stay within FIELD_FACES_PER_RENDER); a multiple of the jobs, so that the jobs
+   get equal shares. */
 static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long all,
                         double frame_s)
 {
-    const long long budget = face_budget(all, spp, w, h, frame_s);
+    const double faces_per_sub = fmax(1.0, (double)all / spp);
     const int most = (spp + jobs - 1) / jobs;
     long long faces = 0;
     int count = 1;
+    double least = INFINITY;
     for (int n = 1; n <= spp; n++) {
         faces += subs[n - 1].stats.faces;
-        if (n > 1 && (faces > budget || n > most))
+        if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most))
             break;
-        if (grid_of(n, w, h))
-            count = n;
+        const int nx = grid_of(n, w, h);
+        const double cost = nx ? cost_per_sub(n, nx, w, h, faces_per_sub, jobs, frame_s) : INFINITY;
+        if (cost < least)
+            least = cost, count = n;
     }
     long long renders = (spp + count - 1) / count;
-    if (renders < (all + budget - 1) / budget)
-        renders = (all + budget - 1) / budget;
     renders = (renders + jobs - 1) / jobs * jobs;
     return (int)(renders < spp ? renders : spp);
 }
