@@ -168,8 +168,9 @@ static double cost_per_sub(int n, int nx, int w, int h, double faces_per_sub, in
 
 /* How many renders: as many as the count of sub-images a render costs least with (of the
    counts that have a grid, that an equal share for every job allows and whose first
-   sub-images stay within FIELD_FACES_PER_RENDER); a multiple of the jobs, so that the jobs
-   get equal shares. */
+   sub-images stay within FIELD_FACES_PER_RENDER); at least as many as all the faces need at
+   FIELD_FACES_PER_RENDER a render; a multiple of the jobs, so that the jobs get equal
+   shares. */
 static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long all,
                         double frame_s)
 {
@@ -188,6 +189,8 @@ static int render_count(const sub *subs, int spp, int w, int h, int jobs, long l
             least = cost, count = n;
     }
     long long renders = (spp + count - 1) / count;
+    if (renders < (all + FIELD_FACES_PER_RENDER - 1) / FIELD_FACES_PER_RENDER)
+        renders = (all + FIELD_FACES_PER_RENDER - 1) / FIELD_FACES_PER_RENDER;
     renders = (renders + jobs - 1) / jobs * jobs;
     return (int)(renders < spp ? renders : spp);
 }
@@ -263,13 +266,15 @@ static int write_include(const camera *c, const sub *subs, const field_render_pl
     return st ? st : outfile_finish(f, err);
 }
 
-/* The includes, written on worker threads (their files opened beforehand: the table of
-   temporary files to remove on a signal is the main thread's). */
+/* The includes, written on worker threads, each opened, written and closed in turn: with a
+   render a sub-image there can be thousands, more than a process may hold open. The table of
+   temporary files to remove on a signal is not thread-safe: opening takes the lock. */
 typedef struct writing {
     const camera *c;
     const sub *subs;
     const field_render_plan *plans;
     const char *placement;
+    const povray_chunk *chunk;
     outfile *inc;
     int renders;
     atomic_int next;
@@ -283,7 +288,11 @@ static void *write_worker(void *arg)
     writing *w = arg;
     for (int r; atomic_load(&w->status) == L2P_OK && (r = atomic_fetch_add(&w->next, 1)) < w->renders;) {
         l2p_error e;
-        const int st = write_include(w->c, w->subs, &w->plans[r], w->placement, &w->inc[r], &e);
+        pthread_mutex_lock(&w->lock);
+        int st = outfile_open(&w->inc[r], w->chunk[r].include_path, &e);
+        pthread_mutex_unlock(&w->lock);
+        if (!st)
+            st = write_include(w->c, w->subs, &w->plans[r], w->placement, &w->inc[r], &e);
         if (st) {
             pthread_mutex_lock(&w->lock);
             if (atomic_load(&w->status) == L2P_OK) {
@@ -448,14 +457,12 @@ static int build_files(const camera *c, const field_files_request *q, field_file
                              .output_exr = name_of(prefix, r, "exr"), .faces = plans[r].faces};
         if (!ch->include_path || !ch->ini_path || !ch->output_exr)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-        if (!st)
-            st = outfile_open(&out->inc[r], ch->include_path, err);
         if (!st && !(st = outfile_open(&out->ini[r], ch->ini_path, err)))
             st = write_ini(&plans[r], ch->output_exr, &out->ini[r], err);
     }
     if (!st) {
         writing w = {.c = c, .subs = subs, .plans = plans, .placement = q->placement,
-                     .inc = out->inc, .renders = renders};
+                     .chunk = out->chunk, .inc = out->inc, .renders = renders};
         st = write_includes(&w, jobs, err);
     }
     out->plans = plans;

@@ -388,9 +388,9 @@ static void build_cell(builder *b, int x0, int y0, int x1, int y1)
         return;
     if (pass == area && try_cell(b, x0, y0, x1, y1))
         return;
-    if (pass < area && try_hull(b, x0, y0, x1, y1))
-        return;
     bool sx = x1 - x0 >= 2, sy = y1 - y0 >= 2;
+    if (pass < area && (sx || sy) && try_hull(b, x0, y0, x1, y1))
+        return;
     if (!sx && !sy) {
         finest(b, x0, y0, x1, y1);
         return;
