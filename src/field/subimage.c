@@ -173,14 +173,20 @@ static bool pixel_ok(const builder *b, const povuv_face *f, int x, int y, double
     return e <= 1.0;
 }
 
+/* Whether the pixel nearest the centroid of the face whose corners are the pixels px is fine
+   with face f: the error of interpolating a smooth field peaks inside a face. */
+static bool centroid_ok(const builder *b, const povuv_face *f, const int px[3][2], double *worst)
+{
+    return pixel_ok(b, f, (px[0][0] + px[1][0] + px[2][0] + 1) / 3, (px[0][1] + px[1][1] + px[2][1] + 1) / 3,
+                    worst);
+}
+
 /* Whether every pixel of [x0, x1] x [y0, y1] is fine with face f, whose corners are the
-   pixels px. The pixel nearest the face's centroid goes first: the error of interpolating a
-   smooth field peaks inside a face, so a face that fails mostly fails there, at once. */
+   pixels px. The centroid goes first: a face that fails mostly fails there, at once. */
 static bool face_ok(const builder *b, const povuv_face *f, const int px[3][2], int x0, int y0, int x1,
                     int y1, double *worst)
 {
-    const int cx = (px[0][0] + px[1][0] + px[2][0] + 1) / 3, cy = (px[0][1] + px[1][1] + px[2][1] + 1) / 3;
-    if (!pixel_ok(b, f, cx, cy, worst))
+    if (!centroid_ok(b, f, px, worst))
         return false;
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++)
@@ -322,29 +328,28 @@ static bool try_hull(builder *b, int x0, int y0, int x1, int y1)
     int hull[2 * HULL_MOST][2];
     if (x1 - x0 > FIELD_BASE_CELL || y1 - y0 > FIELD_BASE_CELL)
         return false;
-    const int n = hull_of(b, x0, y0, x1, y1, hull);
-    if (n < 3)
+    const int faces = hull_of(b, x0, y0, x1, y1, hull) - 2;
+    if (faces < 1)
         return false;
+    int fan[2 * HULL_MOST][3][2];
     povuv_face f[2 * HULL_MOST];
     double worst = 0;
-    for (int k = 1; k + 1 < n; k++) {
-        const int t[3][2] = {{hull[0][0], hull[0][1]}, {hull[k][0], hull[k][1]},
-                             {hull[k + 1][0], hull[k + 1][1]}};
-        pixel_face(b, t, &f[k]);
-        if (!face_ok(b, &f[k], t, x0, y0, x1, y1, &worst))
+    for (int k = 0; k < faces; k++) {
+        memcpy(fan[k][0], hull[0], sizeof fan[k][0]);
+        memcpy(fan[k][1], hull[k + 1], sizeof fan[k][1]);
+        memcpy(fan[k][2], hull[k + 2], sizeof fan[k][2]);
+        pixel_face(b, (const int(*)[2])fan[k], &f[k]);
+        if (!face_ok(b, &f[k], (const int(*)[2])fan[k], x0, y0, x1, y1, &worst))
             return false;
     }
-    for (int k = 1; k + 1 < n; k++) {
-        const int t[3][2] = {{hull[0][0], hull[0][1]}, {hull[k][0], hull[k][1]},
-                             {hull[k + 1][0], hull[k + 1][1]}};
-        emit(b, t, worst);
-    }
+    for (int k = 0; k < faces; k++)
+        emit(b, (const int(*)[2])fan[k], worst);
     /* the pixels the faces hold, as POV-Ray finds them */
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
             double u, v, w[3];
             povuv_pixel_uv(b->m->render_w, b->m->render_h, x, y, &u, &v);
-            for (int k = 1; k + 1 < n && !b->covered[y * b->w + x]; k++) {
+            for (int k = 0; k < faces && !b->covered[y * b->w + x]; k++) {
                 povuv_face_weights(&f[k], u, v, w);
                 b->covered[y * b->w + x] = w[0] >= 0 && w[1] >= 0 && w[2] >= 0;
             }
@@ -362,8 +367,7 @@ static double centroid_error(const builder *b, int x0, int y0, int x1, int y1)
     for (int k = 0; k < 2; k++) {
         povuv_face f;
         pixel_face(b, (const int(*)[2])t[k], &f);
-        pixel_ok(b, &f, (t[k][0][0] + t[k][1][0] + t[k][2][0] + 1) / 3,
-                 (t[k][0][1] + t[k][1][1] + t[k][2][1] + 1) / 3, &worst);
+        centroid_ok(b, &f, (const int(*)[2])t[k], &worst);
     }
     return worst;
 }
