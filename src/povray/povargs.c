@@ -235,24 +235,34 @@ static bool is_ini(const char *a)
            !strcasecmp(a + n - 4, ".ini");
 }
 
+void povargs_default_inis(const char *folder, char buf[POVARGS_INIS][POVARGS_INI_PATH],
+                          const char *ini[POVARGS_INIS])
+{
+    const char *home = getenv("HOME"), *povini = getenv("POVINI");
+    snprintf(buf[1], POVARGS_INI_PATH, "%s/povray.ini", folder);
+    snprintf(buf[2], POVARGS_INI_PATH, "%s/POVRAY.INI", folder);
+    snprintf(buf[3], POVARGS_INI_PATH, "%s/.povray/3.7/povray.ini", home ? home : "");
+    ini[0] = povini && *povini ? povini : NULL;
+    ini[1] = buf[1];
+    ini[2] = buf[2];
+    ini[3] = home && *home ? buf[3] : NULL;
+    ini[4] = "/etc/povray/3.7/povray.ini";
+}
+
 char **povargs_library_paths(const char *folder, char *const *args, int count)
 {
     paths p = {NULL, 0, 0, false};
-    char home_ini[4200], folder_ini[4200], folder_ini_caps[4200];
-    const char *home = getenv("HOME"), *povini = getenv("POVINI");
-    snprintf(home_ini, sizeof home_ini, "%s/.povray/3.7/povray.ini", home ? home : "");
-    snprintf(folder_ini, sizeof folder_ini, "%s/povray.ini", folder);
-    snprintf(folder_ini_caps, sizeof folder_ini_caps, "%s/POVRAY.INI", folder);
-    const char *inis[] = {povini && *povini ? povini : NULL, folder_ini, folder_ini_caps,
-                          home && *home ? home_ini : NULL, "/etc/povray/3.7/povray.ini"};
-    for (size_t i = 0; i < sizeof inis / sizeof *inis; i++)
+    char buf[POVARGS_INIS][POVARGS_INI_PATH];
+    const char *inis[POVARGS_INIS];
+    povargs_default_inis(folder, buf, inis);
+    for (int i = 0; i < POVARGS_INIS; i++)
         take_ini(&p, folder, inis[i]);
     for (int i = 0; i < count; i++) {
         if (!is_ini(args[i])) {
             take_setting(&p, folder, args[i], strlen(args[i]));
             continue;
         }
-        char ini[4200];
+        char ini[POVARGS_INI_PATH];
         snprintf(ini, sizeof ini, "%s%s%s", args[i][0] == '/' ? "" : folder,
                  args[i][0] == '/' ? "" : "/", args[i]);
         take_ini(&p, folder, ini);

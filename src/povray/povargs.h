@@ -24,6 +24,14 @@ void povargs_free(char **args);
    Declare=. Any other (an ini named alone, a Post_Frame_Command=, ...) might. */
 bool povargs_end_with_pictures(char *const *args, int count);
 
+/* The ini files POV-Ray 3.7 may read before the scene run in folder, in order: the one POVINI
+   names, folder's povray.ini and POVRAY.INI, the user's ~/.povray/3.7/povray.ini, the system's
+   /etc/povray/3.7/povray.ini. NULL in place of POVINI's or the user's when POVINI or HOME is
+   unset; the paths are written into buf. */
+enum { POVARGS_INIS = 5, POVARGS_INI_PATH = 4200 };
+void povargs_default_inis(const char *folder, char buf[POVARGS_INIS][POVARGS_INI_PATH],
+                          const char *ini[POVARGS_INIS]);
+
 /* The folders POV-Ray looks in for an #include, after folder (where it runs), with the
    options args: the Library_Path settings and +L options of the ini files it may read (POVINI,
    folder/povray.ini, ~/.povray/3.7/povray.ini, /etc/povray/3.7/povray.ini), of ini files

@@ -116,27 +116,27 @@ size_t lex_block_end(const char *s, size_t n, size_t i)
 
 enum lex_item lex_item_kind(const char *s, size_t a, size_t b)
 {
-    static const char *const types[] = {"perspective", "orthographic", "fisheye",
-                                        "ultra_wide_angle", "omnimax", "panoramic", "spherical",
-                                        "cylinder", "mesh_camera", "user_defined"};
-    static const char *const vectors[] = {"location", "look_at", "direction", "up", "right", "sky",
-                                          "focal_point"};
-    static const char *const transforms[] = {"translate", "rotate", "scale", "matrix", "transform"};
-    static const char *const ignored[] = {"aperture", "blur_samples", "confidence", "variance",
-                                          "normal", "bokeh"};
-    for (size_t k = 0; k < sizeof types / sizeof *types; k++)
-        if (lex_is_word(s, a, b, types[k]))
-            return ITEM_TYPE;
-    for (size_t k = 0; k < sizeof vectors / sizeof *vectors; k++)
-        if (lex_is_word(s, a, b, vectors[k]))
-            return ITEM_VECTOR;
-    for (size_t k = 0; k < sizeof transforms / sizeof *transforms; k++)
-        if (lex_is_word(s, a, b, transforms[k]))
-            return ITEM_TRANSFORM;
-    for (size_t k = 0; k < sizeof ignored / sizeof *ignored; k++)
-        if (lex_is_word(s, a, b, ignored[k]))
-            return ITEM_IGNORED;
-    return lex_is_word(s, a, b, "angle") ? ITEM_ANGLE : ITEM_NONE;
+    static const struct {
+        const char *word;
+        enum lex_item kind;
+    } items[] = {
+        {"perspective", ITEM_TYPE}, {"orthographic", ITEM_TYPE}, {"fisheye", ITEM_TYPE},
+        {"ultra_wide_angle", ITEM_TYPE}, {"omnimax", ITEM_TYPE}, {"panoramic", ITEM_TYPE},
+        {"spherical", ITEM_TYPE}, {"cylinder", ITEM_TYPE}, {"mesh_camera", ITEM_TYPE},
+        {"user_defined", ITEM_TYPE},
+        {"location", ITEM_VECTOR}, {"look_at", ITEM_VECTOR}, {"direction", ITEM_VECTOR},
+        {"up", ITEM_VECTOR}, {"right", ITEM_VECTOR}, {"sky", ITEM_VECTOR},
+        {"focal_point", ITEM_VECTOR},
+        {"translate", ITEM_TRANSFORM}, {"rotate", ITEM_TRANSFORM}, {"scale", ITEM_TRANSFORM},
+        {"matrix", ITEM_TRANSFORM}, {"transform", ITEM_TRANSFORM},
+        {"aperture", ITEM_IGNORED}, {"blur_samples", ITEM_IGNORED}, {"confidence", ITEM_IGNORED},
+        {"variance", ITEM_IGNORED}, {"normal", ITEM_IGNORED}, {"bokeh", ITEM_IGNORED},
+        {"angle", ITEM_ANGLE},
+    };
+    for (size_t k = 0; k < sizeof items / sizeof *items; k++)
+        if (lex_is_word(s, a, b, items[k].word))
+            return items[k].kind;
+    return ITEM_NONE;
 }
 
 size_t lex_item_end(const char *s, size_t close, size_t b)

@@ -80,18 +80,15 @@ static bool ini_sets_frames_or_version(const char *path)
    are POV-Ray's to find. */
 static bool settings_may_differ(const char *dir)
 {
-    const char *home = getenv("HOME"), *povini = getenv("POVINI");
-    char path[4200];
-    bool found = povini && *povini;
-    snprintf(path, sizeof path, "%s/povray.ini", dir);
-    found = found || access(path, F_OK) == 0;
-    snprintf(path, sizeof path, "%s/POVRAY.INI", dir);
-    found = found || access(path, F_OK) == 0;
-    if (home && *home) {
-        snprintf(path, sizeof path, "%s/.povray/3.7/povray.ini", home);
-        found = found || access(path, F_OK) == 0;
-    }
-    return found || ini_sets_frames_or_version("/etc/povray/3.7/povray.ini");
+    char buf[POVARGS_INIS][POVARGS_INI_PATH];
+    const char *ini[POVARGS_INIS];
+    povargs_default_inis(dir, buf, ini);
+    if (ini[0])   /* POVINI named: whatever it holds */
+        return true;
+    for (int i = 1; i < POVARGS_INIS - 1; i++)
+        if (ini[i] && access(ini[i], F_OK) == 0)
+            return true;
+    return ini_sets_frames_or_version(ini[POVARGS_INIS - 1]);
 }
 
 /* The marks of a probe that has done its work, in the order it prints them: the frame line
