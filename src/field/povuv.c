@@ -88,6 +88,15 @@ void povuv_face_init(povuv_face *f, const double pos[3][3], const double nrm[3][
         memcpy(f->uv[1], tuv, sizeof tuv);
     }
     smooth_frame(f);
+    for (int k = 0; k < 3; k++)
+        f->dp[k] = fv(f->p[k]);
+    f->dn1 = fv(f->n[0]);
+    f->dn21 = v3_sub(fv(f->n[1]), f->dn1);
+    f->dn32 = v3_sub(fv(f->n[2]), fv(f->n[1]));
+    f->dperp = fv(f->perp);
+    f->p1v = f->p[0][f->vaxis];
+    f->p2v = f->p[1][f->vaxis];
+    f->p32v = (double)f->p[2][f->vaxis] - f->p[1][f->vaxis];
 }
 
 /* tracepixel.cpp: scale = (P2-P1) x (P3-P1) in UV; B1 = ((P2-X) x (P3-X)) / scale, and so on
@@ -110,20 +119,17 @@ bool povuv_face_ray(const povuv_face *f, double u, double v, vec3 *o, vec3 *d)
 
 bool povuv_weighted_ray(const povuv_face *f, const double b[3], vec3 *o, vec3 *d)
 {
-    vec3 p1 = fv(f->p[0]), p2 = fv(f->p[1]), p3 = fv(f->p[2]);
-    *o = v3_add(v3_add(v3_scale(p1, b[0]), v3_scale(p2, b[1])), v3_scale(p3, b[2]));
-    const float(*n)[3] = f->n;
-    vec3 n1 = fv(n[0]), n2 = fv(n[1]), n3 = fv(n[2]);
+    const vec3 *p = f->dp;
+    *o = v3_add(v3_add(v3_scale(p[0], b[0]), v3_scale(p[1], b[1])), v3_scale(p[2], b[2]));
     /* Smooth_Mesh_Normal: u measures from P1 (0) to edge P2-P3 (1) along Perp; the line from
        P1 through the point meets that edge at v (one coordinate, the edge's dominant axis);
        N = N1 + u (N2 - N1 + v (N3 - N2)). */
-    vec3 rel = v3_sub(*o, p1);
-    double uu = v3_dot(rel, fv(f->perp));
-    vec3 r = n1;
+    const vec3 rel = v3_sub(*o, p[0]);
+    const double uu = v3_dot(rel, f->dperp);
+    vec3 r = f->dn1;
     if (!(uu < POV_EPSILON)) {
-        int ax = f->vaxis;
-        double vv = (axis_of(rel, ax) / uu + axis_of(p1, ax) - axis_of(p2, ax)) / (axis_of(p3, ax) - axis_of(p2, ax));
-        r = v3_add(n1, v3_scale(v3_add(v3_sub(n2, n1), v3_scale(v3_sub(n3, n2), vv)), uu));
+        const double vv = (axis_of(rel, f->vaxis) / uu + f->p1v - f->p2v) / f->p32v;
+        r = v3_add(f->dn1, v3_scale(v3_add(f->dn21, v3_scale(f->dn32, vv)), uu));
     }
     double len = v3_length(r);
     if (!(len > 0.0) || !isfinite(len))

@@ -20,6 +20,10 @@ typedef struct povuv_face {
     int vaxis;
     bool swapped;       /* vertices 1 and 2 (and their UVs) swapped */
     bool smooth;        /* normals not all equal: |N1 - N2|^2 or |N1 - N3|^2 above 1e-10 */
+    /* The same in double, as povuv_weighted_ray uses them at every pixel: P1, P2, P3, N1,
+       N2 - N1, N3 - N2, Perp, and along vaxis P1, P2 and P3 - P2. */
+    vec3 dp[3], dn1, dn21, dn32, dperp;
+    double p1v, p2v, p32v;
 } povuv_face;
 
 /* A face from its file values (vertex k of the face: position, normal, UV). */

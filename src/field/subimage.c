@@ -33,7 +33,8 @@ int field_render_size(int n)
 typedef struct builder {
     const camera *c;
     const field_tolerance *tol;
-    double sin_angle;          /* sin(tol->angle_rad) */
+    double per_sin2;           /* 1 / sin(tol->angle_rad)^2 */
+    double per_origin2;        /* 1 / tol->origin_mm^2 */
     int w, h;
     ray *rays;                 /* mesh space: camera space less the front vertex */
     unsigned char *passed, *covered;
@@ -142,20 +143,22 @@ static void pixel_face(const builder *b, const int px[3][2], povuv_face *f)
     povuv_face_init(f, pos, nrm, uv);
 }
 
-/* The error of the model's ray against the exact one, in units of the tolerance. For unit
-   directions |a x b| is the sine of the angle between them: below a right angle, comparing
-   sines is comparing angles, without an atan2 at every pixel. */
-static double ray_error(const builder *b, const ray *exact, vec3 o, vec3 d)
+/* The square of the error of the model's ray against the exact one, in units of the
+   tolerance. For unit directions |a x b| is the sine of the angle between them: below a right
+   angle, comparing sines is comparing angles, without an atan2 at every pixel; squares spare
+   the square roots. */
+static double ray_error_squared(const builder *b, const ray *exact, vec3 o, vec3 d)
 {
-    const double turn = v3_dot(exact->d, d) > 0
-                            ? v3_length(v3_cross(exact->d, d)) / b->sin_angle : INFINITY;
+    const vec3 turn = v3_cross(exact->d, d);
     vec3 e = v3_sub(o, exact->o);
     vec3 across = v3_sub(e, v3_scale(exact->d, v3_dot(e, exact->d)));
-    return fmax(turn, v3_length(across) / b->tol->origin_mm);
+    return v3_dot(exact->d, d) > 0
+               ? fmax(v3_dot(turn, turn) * b->per_sin2, v3_dot(across, across) * b->per_origin2)
+               : INFINITY;
 }
 
 /* Whether pixel (x, y) is fine with face f: outside it, or inside with a ray within the
-   tolerance. */
+   tolerance. *worst is the largest error seen, in units of the tolerance. */
 static bool pixel_ok(const builder *b, const povuv_face *f, int x, int y, double *worst)
 {
     double u, v, w[3];
@@ -168,9 +171,10 @@ static bool pixel_ok(const builder *b, const povuv_face *f, int x, int y, double
     vec3 o, d;
     if (!povuv_weighted_ray(f, w, &o, &d))
         return false;
-    double e = ray_error(b, &b->rays[y * b->w + x], o, d);
-    *worst = fmax(*worst, e);
-    return e <= 1.0;
+    const double e2 = ray_error_squared(b, &b->rays[y * b->w + x], o, d);
+    if (e2 > *worst * *worst)
+        *worst = sqrt(e2);
+    return e2 <= 1.0;
 }
 
 /* Whether the pixel nearest the centroid of the face whose corners are the pixels px is fine
@@ -480,7 +484,8 @@ static void build_grid(builder *b, int base)
 int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
                          field_mesh *out, float *weights, field_stats *st, l2p_error *err)
 {
-    builder b = {.c = c, .tol = t, .sin_angle = sin(t->angle_rad),
+    builder b = {.c = c, .tol = t, .per_sin2 = 1.0 / (sin(t->angle_rad) * sin(t->angle_rad)),
+                 .per_origin2 = 1.0 / (t->origin_mm * t->origin_mm),
                  .w = c->crop_x1 - c->crop_x0, .h = c->crop_y1 - c->crop_y0,
                  .m = out, .st = st, .weights = weights};
     const size_t n = (size_t)b.w * b.h;

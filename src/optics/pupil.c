@@ -188,19 +188,26 @@ static double radius_toward(const pupil *pu, double dx, double dy, double c, dou
    direction. The angle of d is kept, so a fixed sample moves continuously with the film
    point, also across the axis, where R is constant. A sector of the unit disk (area dphi / 2)
    maps onto one of area R^2 dphi / 2: the density is 1 / (pi R^2). */
-bool pupil_point(const pupil *pu, vec3 film_point, double u, double v, double *x_mm,
-                 double *y_mm, double *inverse_density_mm2)
+static bool pupil_point_of_disk(const pupil *pu, vec3 film_point, double dx, double dy,
+                                double *x_mm, double *y_mm, double *inverse_density_mm2)
 {
-    double cx, cy, c, s, f = 0.0, dx, dy;
+    double cx, cy, c, s, f = 0.0;
     int j;
     if (!locate(pu, film_point, &cx, &cy, &c, &s, &j, &f))
         return false;
-    disk_point(u, v, &dx, &dy);
     const double radius = radius_toward(pu, dx, dy, c, s, j, f);
     *x_mm = cx + radius * dx;
     *y_mm = cy + radius * dy;
     *inverse_density_mm2 = M_PI * radius * radius;
     return true;
+}
+
+bool pupil_point(const pupil *pu, vec3 film_point, double u, double v, double *x_mm,
+                 double *y_mm, double *inverse_density_mm2)
+{
+    double dx, dy;
+    disk_point(u, v, &dx, &dy);
+    return pupil_point_of_disk(pu, film_point, dx, dy, x_mm, y_mm, inverse_density_mm2);
 }
 
 bool pupil_contains(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
@@ -217,9 +224,13 @@ bool pupil_contains(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 void pupil_film_rays(const pupil *pu, int n, const vec3 *film_points, const double *u,
                      const double *v, vec3 *directions, double *weights)
 {
+    double dx = 0.0, dy = 0.0;
     for (int k = 0; k < n; k++) {
         double x, y, area;   /* the inverse density: the area of a uniform region */
-        if (!pupil_point(pu, film_points[k], u[k], v[k], &x, &y, &area)) {
+        /* a ray field shares one sample among all its pixels: its disk point once */
+        if (k == 0 || u[k] != u[k - 1] || v[k] != v[k - 1])
+            disk_point(u[k], v[k], &dx, &dy);
+        if (!pupil_point_of_disk(pu, film_points[k], dx, dy, &x, &y, &area)) {
             directions[k] = v3(0.0, 0.0, 1.0);
             weights[k] = 0.0;
             continue;
