@@ -82,7 +82,7 @@ static void check_subimage(const char *lens, camera_options *o, double tol, uint
     field_mesh m;
     field_mesh_init(&m, field_render_size(w), field_render_size(h));
     l2p_error err;
-    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_BASE_CELL, &m, NULL, st, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_COARSEST_CELL, &m, NULL, st, &err), L2P_OK, "%s", err.text);
     char *text = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);
@@ -196,6 +196,19 @@ Test(field, the_image_circles_rim_takes_fewer_faces_than_its_pixels)
     camera_free(&c);
 }
 
+/* A field that bends little (the telephoto's) is drawn by cells larger than the base grid:
+   fewer faces than the base grid's two a cell, every pixel still checked against its exact
+   ray by check_subimage. */
+Test(field, a_gentle_field_takes_cells_larger_than_the_base_grid)
+{
+    camera_options o = small(320, 240);
+    field_stats st;
+    check_subimage("telephoto.250mm", &o, 0.05, 1, &st);
+    const int base = 2 * ((320 - 1 + FIELD_BASE_CELL - 1) / FIELD_BASE_CELL) *
+                     ((240 - 1 + FIELD_BASE_CELL - 1) / FIELD_BASE_CELL);
+    cr_expect(st.faces < base / 2, "%d faces, the base grid alone %d", st.faces, base);
+}
+
 Test(field, a_crop_every_pixel_within_the_tolerance)
 {
     camera_options o = small(320, 240);
@@ -224,7 +237,7 @@ Test(field, sub_images_moved_into_a_render_keep_their_rays)
         field_stats st;
         l2p_error err;
         field_mesh_init(&m, field_render_size(w), field_render_size(h));
-        cr_assert_eq(field_build_subimage(&c, sobol_shared_sample(o.seed, (uint32_t)k), &t, FIELD_BASE_CELL,
+        cr_assert_eq(field_build_subimage(&c, sobol_shared_sample(o.seed, (uint32_t)k), &t, FIELD_COARSEST_CELL,
                                           &m, NULL, &st, &err), L2P_OK);
         cr_assert_eq(field_mesh_append(&render, &m, dx[k], 0), 0);
         field_mesh_free(&m);

@@ -95,7 +95,7 @@ static field_layout field_layout_of(const cli *c, int jobs)
     int w, h;
     crop_size(&c->cam, &w, &h);
     field_layout l = {.pixels = (double)w * h, .spp = c->cam.spp};
-    const double cells = ceil((w - 1.0) / FIELD_BASE_CELL) * ceil((h - 1.0) / FIELD_BASE_CELL);
+    const double cells = ceil((w - 1.0) / FIELD_COARSEST_CELL) * ceil((h - 1.0) / FIELD_COARSEST_CELL);
     const double coarsest = fmax(1.0, 2.0 * cells);
     const double most = ceil(l.spp / (jobs > 0 ? jobs : 1));
     l.subimage_faces = field_subimage_faces(c, w, h, coarsest);

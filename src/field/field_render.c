@@ -59,7 +59,7 @@ static void *build_worker(void *arg)
         l2p_error e;
         s->weights = malloc(pixels * sizeof *s->weights);
         const film_sample shared = field_shared_sample(j->c, k, &s->band);
-        int st = s->weights ? field_build_subimage(j->c, shared, j->tol, FIELD_BASE_CELL, &s->mesh,
+        int st = s->weights ? field_build_subimage(j->c, shared, j->tol, FIELD_COARSEST_CELL, &s->mesh,
                                                    s->weights, &s->stats, &e)
                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
         if (!st && !(s->stats.worst_pixels <= j->tol->pixels))

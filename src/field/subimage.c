@@ -387,6 +387,29 @@ static bool halve_along_x(const builder *b, int x0, int y0, int x1, int y1)
            centroid_error(b, x0, y0, x1, my) + centroid_error(b, x0, my, x1, y1);
 }
 
+static void build_cell(builder *b, int x0, int y0, int x1, int y1);
+
+/* The four cells of [x0, x1] x [y0, y1] about (mx, my); only two when one side stays whole
+   (mx == x1 or my == y1). */
+static void split_four(builder *b, int x0, int y0, int x1, int y1, int mx, int my)
+{
+    build_cell(b, x0, y0, mx, my);
+    if (mx < x1)
+        build_cell(b, mx, y0, x1, my);
+    if (my < y1)
+        build_cell(b, x0, my, mx, y1);
+    if (mx < x1 && my < y1)
+        build_cell(b, mx, my, x1, y1);
+}
+
+/* The base grid's line nearest the middle of [a0, a1], which is more than one base cell long
+   and starts on the grid. */
+static int base_middle(int a0, int a1)
+{
+    const int cells = (a1 - a0 + FIELD_BASE_CELL - 1) / FIELD_BASE_CELL;
+    return a0 + FIELD_BASE_CELL * ((cells + 1) / 2);
+}
+
 static void build_cell(builder *b, int x0, int y0, int x1, int y1)
 {
     if (b->oom || x1 <= x0 || y1 <= y0)
@@ -396,6 +419,13 @@ static void build_cell(builder *b, int x0, int y0, int x1, int y1)
         return;
     if (pass == area && try_cell(b, x0, y0, x1, y1))
         return;
+    /* Larger than the base grid: tried whole, else split on the base grid, so that below it
+       the mesh is the one the base grid alone makes. */
+    const bool big_x = x1 - x0 > FIELD_BASE_CELL, big_y = y1 - y0 > FIELD_BASE_CELL;
+    if (big_x || big_y) {
+        split_four(b, x0, y0, x1, y1, big_x ? base_middle(x0, x1) : x1, big_y ? base_middle(y0, y1) : y1);
+        return;
+    }
     bool sx = x1 - x0 >= 2, sy = y1 - y0 >= 2;
     if (pass < area && (sx || sy) && try_hull(b, x0, y0, x1, y1))
         return;
@@ -413,14 +443,7 @@ static void build_cell(builder *b, int x0, int y0, int x1, int y1)
         build_cell(b, along_x ? mx : x0, along_x ? y0 : my, x1, y1);
         return;
     }
-    int mx = sx ? (x0 + x1) / 2 : x1, my = sy ? (y0 + y1) / 2 : y1;
-    build_cell(b, x0, y0, mx, my);
-    if (sx)
-        build_cell(b, mx, y0, x1, my);
-    if (sy)
-        build_cell(b, x0, my, mx, y1);
-    if (sx && sy)
-        build_cell(b, mx, my, x1, y1);
+    split_four(b, x0, y0, x1, y1, sx ? (x0 + x1) / 2 : x1, sy ? (y0 + y1) / 2 : y1);
 }
 
 /* ---------------------------------------------------------------- lone pixels */

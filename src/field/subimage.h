@@ -27,7 +27,10 @@ typedef struct field_stats {
     double worst_pixels;       /* largest error of a covered pixel, in the tolerance's pixels */
 } field_stats;
 
-enum { FIELD_BASE_CELL = 32 };   /* pixels between the vertices of the coarsest grid */
+/* Pixels between the vertices of the coarsest grid, and of the base grid on which a coarsest
+   cell that fails is split: below the base grid the mesh follows the field, its edges, halving
+   and hulls; above it only whole cells are tried. */
+enum { FIELD_COARSEST_CELL = 128, FIELD_BASE_CELL = 32 };
 
 /* The crop of camera c (crop_x0..crop_x1, crop_y0..crop_y1) seen with shared sample s, as a
    mesh for a render of exactly the crop's size (vertex pixel positions are crop pixels):
