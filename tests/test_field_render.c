@@ -127,6 +127,29 @@ Test(field_render, default_falls_back_to_pixel_sampling_on_a_tiny_film)
     free(a), free(b);
 }
 
+/* A render none of whose pixels the lens passes (a crop beyond the fisheye's image circle)
+   still gets a mesh POV-Ray accepts, which gives no pixel a ray: the picture is black. Before,
+   its empty mesh stopped POV-Ray ("No vertices in triangle mesh"). */
+Test(field_render, a_render_the_lens_blocks_everywhere_is_black)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    char *errtext = NULL;
+    int st = L2P(NULL, &errtext, "render", tmp_path(dir, "scene.pov"), LENS_DIR "fisheye.10mm.dat",
+                 "--width", "96", "--height", "72", "--crop", "0,0,5,5", "--spp", "4", "--jobs", "2",
+                 "--sampling", "field", "--quiet", "-o", tmp_path(dir, "corner.exr"));
+    cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+    free(errtext);
+    int w, h;
+    float *px;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "corner.exr"), &w, &h, &px, &err), 0, "%s", err.text);
+    cr_assert(w == 5 && h == 5);
+    for (int i = 0; i < 5 * 5 * 4; i++)
+        cr_expect(px[i] == 0.0f || (i % 4 == 3), "pixel %d channel %d: %g", i / 4, i % 4, px[i]);
+    free(px);
+}
+
 /* How sub-images are packed into renders (here: one render of 4 with one job, two of 2 with
    two) changes no pixel: every UV is a short binary fraction, so every pixel gets the same
    face weights, hence the same ray, in any render. A crop is the crop's size. */

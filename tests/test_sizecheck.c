@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include "cli/sizecheck.h"
@@ -136,6 +137,29 @@ Test(sizecheck, a_field_render_stays_within_its_estimate)
     free(peaks);
     cr_expect_eq(processes, 2);
     cr_expect_leq(e.povray_process_bytes, e.memory_bytes);
+}
+
+/* Many sub-images of a tiny film: lens2pov's own peak memory (trace: no POV-Ray; the test
+   process's only child, so RUSAGE_CHILDREN's largest) stays within the estimate of a render
+   with the same options. Each sub-image's mesh was kept with room for 1024 vertices and
+   faces, 556 MB here (28 kB a sub-image) against an estimate of 60 MB. */
+Test(sizecheck, many_sub_images_of_a_tiny_film_stay_within_the_estimate)
+{
+    const char *dir = test_tmpdir();
+    char prefix[1024];
+    snprintf(prefix, sizeof prefix, "%s/tiny", dir);
+    char *args[] = {"s.pov", LENS_DIR "dgauss.50mm.dat", "--width", "2", "--height", "2", "--spp", "20000",
+                    "--location", "0,1,-4", "--look-at", "0,1,0", "--sampling", "field", "--jobs", "2",
+                    "-o", "x.exr"};
+    const size_estimate e = estimate_of(args, sizeof args / sizeof args[0], 2);
+    run_lens2pov_ok("trace", "trace", LENS_DIR "dgauss.50mm.dat", "--width", "2", "--height", "2", "--spp",
+                    "20000", "--location", "0,1,-4", "--look-at", "0,1,0", "--sampling", "field", "--quiet",
+                    "-o", prefix, NULL);
+    struct rusage ru;
+    cr_assert_eq(getrusage(RUSAGE_CHILDREN, &ru), 0);
+    const double peak = (double)ru.ru_maxrss * 1024.0;
+    cr_log_info("trace: peak %.1f MB, estimate %.1f MB", peak / 1e6, e.memory_bytes / 1e6);
+    cr_expect_leq(peak, e.memory_bytes, "lens2pov took %.0f bytes", peak);
 }
 
 /* The smallest power of two above n: POV-Ray's side of a render whose final side holds n. */

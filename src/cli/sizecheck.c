@@ -108,15 +108,15 @@ static field_layout field_layout_of(const cli *c, int jobs)
 }
 
 /* lens2pov keeps every sub-image's mesh until the renders are written: a face (field_mesh's
-   tri) and a vertex (pos, nrm, pix, uv) a face, as a triangulated grid has half as many
-   vertices as faces and arrays grown by doubling hold up to twice what they use. Meanwhile it
+   tri) and a vertex (pos, nrm, pix, uv) a face, a margin over the half as many vertices as
+   faces of a triangulated grid, and SIZE_FIELD_BYTES_PER_SUBIMAGE. Meanwhile it
    builds on jobs threads (a crop pixel's ray, weight, flags, prefix sum and vertex index,
    subimage.c), waits for POV-Ray's processes, then develops (the sums, a sub-image's
    weights, a render's picture as float RGBA). */
 static void field_memory(const field_layout *l, int jobs, size_estimate *e)
 {
     const double mesh_face = 3 * sizeof(int) + 6 * sizeof(float) + 4 * sizeof(double);
-    const double meshes = l->spp * l->subimage_faces * mesh_face;
+    const double meshes = l->spp * (l->subimage_faces * mesh_face + SIZE_FIELD_BYTES_PER_SUBIMAGE);
     const double build = jobs * l->pixels * (sizeof(ray) + sizeof(float) + 2 + 2 * sizeof(int));
     e->povray_process_bytes = POVRAY_BASE_BYTES +
                               l->render_faces * SIZE_FIELD_POVRAY_BYTES_PER_FACE +

@@ -72,6 +72,8 @@ static void *build_worker(void *arg)
                           "use a larger tolerance or --sampling pixel", j->tol->pixels,
                           s->stats.faces, pixels, k);
         const bool too_fine = st == L2P_BAD_INPUT;   /* the two refusals above */
+        if (!st && field_mesh_shrink(&s->mesh) < 0)   /* kept until the renders are written */
+            st = l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
         if (!st)   /* into the map now: spp of them in memory would be spp pictures */
             st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
         free(s->weights);

@@ -2,6 +2,7 @@
 #include "field/fieldmesh.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,7 +25,7 @@ static int grow(void **p, int *cap, int need, size_t size)
 {
     if (need <= *cap)
         return 0;
-    int n = *cap ? *cap * 2 : 1024;
+    int n = *cap ? *cap * 2 : 16;
     while (n < need)
         n *= 2;
     void *q = realloc(*p, (size_t)n * size);
@@ -58,6 +59,26 @@ int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double x, double y)
     m->uv[k][0] = x / (m->render_w + 1);
     m->uv[k][1] = 1.0 - (y + 1) / (m->render_h + 1);
     return k;
+}
+
+/* realloc to n elements of size, n at least 1; false only when it fails */
+static bool fit(void **p, int n, size_t size)
+{
+    void *q = realloc(*p, (size_t)(n > 0 ? n : 1) * size);
+    if (q)
+        *p = q;
+    return q != NULL;
+}
+
+int field_mesh_shrink(field_mesh *m)
+{
+    if (!fit((void **)&m->pos, m->vertices, sizeof *m->pos) || !fit((void **)&m->nrm, m->vertices, sizeof *m->nrm) ||
+        !fit((void **)&m->pix, m->vertices, sizeof *m->pix) || !fit((void **)&m->uv, m->vertices, sizeof *m->uv) ||
+        !fit((void **)&m->tri, m->faces, sizeof *m->tri))
+        return -1;
+    m->vertex_cap = m->vertices > 0 ? m->vertices : 1;
+    m->face_cap = m->faces > 0 ? m->faces : 1;
+    return 0;
 }
 
 int field_mesh_face(field_mesh *m, int a, int b, int c)
@@ -130,6 +151,8 @@ void field_mesh_povuv_face(const field_mesh *m, int k, povuv_face *f)
     povuv_face_init(f, pos, nrm, uv);
 }
 
+static int write_camera(FILE *out, const char *name, const double world[12], const char *placement);
+
 /* %.9g gives back a float32 exactly; %.17g a dyadic UV exactly (it has few digits). */
 int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, const double world[12],
                              const char *placement)
@@ -137,6 +160,16 @@ int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, c
     /* as the pixel table's include (docs/povray.md, "Output and gamma"): raise the language
        version to 3.7 only when it is lower, and put it back */
     fprintf(out, "#if (version < 3.7)\n  #declare Lens2pov_Version = version;\n  #version 3.7;\n#end\n");
+    if (m->faces == 0) {
+        /* A render none of whose pixels the lens passes (POV-Ray refuses a mesh without
+           faces): one face of zero area, in space and in UV, with equal normals. Every
+           pixel's UV weights in it are 0/0, so POV-Ray takes it for none, as povuv_mesh_find
+           does: all pixels black, alpha 0. */
+        fprintf(out, "#declare %s = mesh2 {\n  vertex_vectors { 3, <0,0,0>, <0,0,0>, <0,0,0> }\n"
+                     "  normal_vectors { 3, <0,0,1>, <0,0,1>, <0,0,1> }\n"
+                     "  uv_vectors { 3, <0,0>, <0,0>, <0,0> }\n  face_indices { 1, <0,1,2> }\n", name);
+        return write_camera(out, name, world, placement);
+    }
     fprintf(out, "#declare %s = mesh2 {\n  vertex_vectors { %d", name, m->vertices);
     for (int i = 0; i < m->vertices; i++)
         fprintf(out, ",\n<%.9g,%.9g,%.9g>", m->pos[i][0], m->pos[i][1], m->pos[i][2]);
@@ -149,7 +182,14 @@ int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, c
     fprintf(out, " }\n  face_indices { %d", m->faces);
     for (int i = 0; i < m->faces; i++)
         fprintf(out, ",\n<%d,%d,%d>", m->tri[i][0], m->tri[i][1], m->tri[i][2]);
-    fprintf(out, " }\n  hierarchy off\n}\n");
+    fprintf(out, " }\n");
+    return write_camera(out, name, world, placement);
+}
+
+/* The end of the mesh, and the camera of it with its transforms. */
+static int write_camera(FILE *out, const char *name, const double world[12], const char *placement)
+{
+    fprintf(out, "  hierarchy off\n}\n");
     fprintf(out, "camera { mesh_camera { 1 3 mesh { %s matrix <", name);
     for (int i = 0; i < 12; i++)
         fprintf(out, "%.17g%s", world[i], i < 11 ? ", " : "");
