@@ -176,10 +176,12 @@ static double centre_mean_weight(const camera *c)
         else
             out = mid;
     }
+    /* the pupil camera_trace draws from, at the d line */
+    const pupil *pu = camera_pupil_at(c, WAVELENGTH_D_NM);
     pupil_shape disk;
-    if (!pupil_shape_at(&c->pupil, 0.0, &disk))
+    if (!pupil_shape_at(pu, 0.0, &disk))
         return 0.0;
-    const double rho = in * disk.radius_mm[0], z = c->pupil.z_mm;
+    const double rho = in * disk.radius_mm[0], z = pu->z_mm;
     return M_PI * rho * rho / (z * z + rho * rho);
 }
 
@@ -241,20 +243,93 @@ static int setup_dispersion(camera *c, const camera_options *o, l2p_error *err)
     return L2P_OK;
 }
 
-/* With dispersion the pupil fitted at the d line also covers the two ends of the spectrum;
-   between them the passing regions move little and smoothly (pupil_cover). */
+/* Covers pupil p for the lens at wavelength nm (pupil_cover). */
+static int cover_at(pupil *p, const lens *l, double nm, l2p_error *err)
+{
+    lens at;
+    if (lens_copy(&at, l))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    lens_at_wavelength(&at, nm);
+    pupil_cover(p, &at);
+    lens_free(&at);
+    return L2P_OK;
+}
+
+static double spectral_nm(int i)
+{
+    return SPECTRUM_MIN_NM + i * (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) / (CAMERA_SPECTRAL_PUPILS - 1);
+}
+
+/* The largest ratio, over the film's radius, of the area of pupil b's region to that of a's:
+   the same pupil before and after pupil_cover. */
+static double grown_area(const pupil *a, const pupil *b)
+{
+    double most = 1.0;
+    for (double r = 0.0; r <= a->node_spacing_mm * PUPIL_NODES; r += a->node_spacing_mm) {
+        pupil_shape ea, eb;
+        if (!pupil_shape_at(a, r, &ea) || !pupil_shape_at(b, r, &eb))
+            continue;
+        double sa = 0.0, sb = 0.0;
+        for (int i = 0; i <= PUPIL_KNOTS; i++)
+            sa += ea.radius_mm[i] * ea.radius_mm[i], sb += eb.radius_mm[i] * eb.radius_mm[i];
+        if (sa > 0.0)
+            most = fmax(most, sb / sa);
+    }
+    return most;
+}
+
+/* Spectral pupils are fitted when covering the spectrum grows the region more than this: a
+   sample then passes less than two times in three as often as with a region for its own
+   wavelength, and the fits (a few tenths of a second) are worth it. */
+#define SPECTRAL_WORTH 1.5
+
+/* With dispersion the pupil fitted at the d line also covers the two ends of the spectrum
+   (between them the passing regions move little and smoothly: pupil_cover); it bounds the
+   film's reach. Samples are drawn from spectral pupils instead: each fitted at its wavelength,
+   in the same plane, and covered at its neighbours'. Through a small stop the passing region
+   moves with the wavelength by more than its own size, so one region for the whole spectrum
+   passed a fifth of the samples a region for one wavelength passes. */
 static int cover_spectrum(camera *c, l2p_error *err)
 {
-    const double ends[2] = {SPECTRUM_MIN_NM, SPECTRUM_MAX_NM};
-    for (int i = 0; i < 2; i++) {
+    pupil *d_line = malloc(sizeof *d_line);
+    if (!d_line)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    *d_line = c->pupil;
+    int st = cover_at(&c->pupil, &c->lens, SPECTRUM_MIN_NM, err);
+    if (!st)
+        st = cover_at(&c->pupil, &c->lens, SPECTRUM_MAX_NM, err);
+    const bool worth = !st && grown_area(d_line, &c->pupil) > SPECTRAL_WORTH;
+    free(d_line);
+    if (!worth)
+        return st;
+    if (!(c->spectral = malloc(sizeof *c->spectral * CAMERA_SPECTRAL_PUPILS)))
+        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i = 0; i < CAMERA_SPECTRAL_PUPILS && !st; i++) {
+        pupil *p = &c->spectral[i];
         lens at;
-        if (lens_copy(&at, &c->lens))
-            return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-        lens_at_wavelength(&at, ends[i]);
-        pupil_cover(&c->pupil, &at);
+        *p = c->pupil;
+        if (lens_copy(&at, &c->lens)) {
+            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+            break;
+        }
+        lens_at_wavelength(&at, spectral_nm(i));
+        pupil_fit(p, &at, 0.5 * c->film.diagonal_mm);
         lens_free(&at);
+        if (i > 0)
+            st = cover_at(p, &c->lens, spectral_nm(i - 1), err);
+        if (!st && i + 1 < CAMERA_SPECTRAL_PUPILS)
+            st = cover_at(p, &c->lens, spectral_nm(i + 1), err);
     }
-    return L2P_OK;
+    return st;
+}
+
+const pupil *camera_pupil_at(const camera *c, double nm)
+{
+    if (!c->spectral)
+        return &c->pupil;
+    const double t = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * (CAMERA_SPECTRAL_PUPILS - 1);
+    const int i = t > 0.0 ? (int)(t + 0.5) : 0;
+    return &c->spectral[i < CAMERA_SPECTRAL_PUPILS ? i : CAMERA_SPECTRAL_PUPILS - 1];
 }
 
 int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
@@ -312,6 +387,7 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
 void camera_free(camera *c)
 {
     lens_free(&c->lens);
+    free(c->spectral);
     memset(c, 0, sizeof *c);
 }
 
@@ -347,7 +423,14 @@ void camera_trace_batch(const camera *c, sample_batch *s)
     const int n = s->n;
     trace_batch b;
     vec3 direction[CAMERA_BATCH];
-    pupil_film_rays(&c->pupil, n, s->film_point, s->u, s->v, direction, s->weight);
+    /* runs of samples of one wavelength (all of a ray field's), each from its pupil */
+    for (int k = 0, end; k < n; k = end) {
+        end = c->dispersion ? k + 1 : n;
+        while (end < n && s->wavelength_nm[end] == s->wavelength_nm[k])
+            end++;
+        pupil_film_rays(c->dispersion ? camera_pupil_at(c, s->wavelength_nm[k]) : &c->pupil, end - k,
+                        s->film_point + k, s->u + k, s->v + k, direction + k, s->weight + k);
+    }
     for (int k = 0; k < n; k++) {
         s->weight[k] *= c->weight_scale;
         b.status[k] = s->weight[k] > 0.0 && isfinite(s->weight[k]) && v3_isfinite(direction[k])

@@ -44,7 +44,10 @@ void camera_options_default(camera_options *o);
 typedef struct camera {
     lens lens;                 /* at the chosen film distance and stop opening */
     film film;
-    pupil pupil;
+    pupil pupil;               /* with dispersion, covering the whole spectrum */
+    /* With dispersion, CAMERA_SPECTRAL_PUPILS pupils fitted at wavelengths evenly spaced over
+       the spectrum, each covering its neighbours' (camera_pupil_at); else NULL. */
+    pupil *spectral;
     thick_lens thick;          /* thick lens of the whole lens (for --trace thick and info) */
     trace_kind trace;
     weighting weighting;
@@ -58,6 +61,13 @@ typedef struct camera {
     vec3 location, right, up, forward;
     double unit_mm;
 } camera;
+
+enum { CAMERA_SPECTRAL_PUPILS = 9 };
+
+/* The pupil a sample of wavelength nm is drawn from: with dispersion, the spectral pupil
+   nearest nm, which holds every ray the lens passes between the midpoints to its neighbours;
+   else the pupil. */
+const pupil *camera_pupil_at(const camera *c, double nm);
 
 /* Takes ownership of the lens. Validates the options against the lens (L2P_BAD_INPUT with a
    message for a focus closer than the lens allows, an aperture larger than the stop, ...). */
