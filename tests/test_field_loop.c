@@ -144,7 +144,7 @@ Test(field_loop, an_error_in_one_frame_fails_the_render_with_its_message)
                                 "0,1,-4", "--look-at", "0,0.6,0", "--sampling", "field", "--jobs",
                                 "1", "--keep-temp", work, "--quiet", "-o", out, (char *)NULL);
     unsetenv("LENS2POV_POVRAY");
-    cr_expect_eq(st, 1, "status %d: %s", st, errtext ? errtext : "");
+    cr_expect_eq(st, 2, "status %d: %s", st, errtext ? errtext : "");
     char expected[1200];
     snprintf(expected, sizeof expected, "%s:8: Parse halted by #error directive: this scene renders once",
              scene);

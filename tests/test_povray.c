@@ -217,7 +217,7 @@ Test(povray, scene_paths_that_are_not_ascii_work_and_errors_name_them)
 
     write_text(mine, "#declare MyColour = rgb 0.5;\nsphere { 0, 1 pigment { foo } }\n");
     povray_options o = options(scene, dir, 1);
-    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_FAILED);
+    cr_assert_eq(povray_render_chunks(fx.chunk, 1, &o, &err), L2P_BAD_INPUT);
     char *expected = fmt("%s:%s: ", mine, "2");
     cr_expect(strncmp(err.text, expected, strlen(expected)) == 0, "%s", err.text);
     free(expected);
@@ -237,8 +237,8 @@ Test(povray, a_syntax_error_names_the_file_and_line)
                     "sphere { <0,0,0>, 1 pigment { rgb 1 }\nbox { 0, 1 }\n");
     fixture fx;
     l2p_error err = {0};
-    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_FAILED);
-    cr_assert_eq(err.status, L2P_FAILED);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_BAD_INPUT);
+    cr_assert_eq(err.status, L2P_BAD_INPUT);
     char *expected = fmt("%s:4: No matching } in 'sphere', box found instead%s", scene, "");
     cr_expect_str_eq(err.text, expected);
     free(expected);
@@ -255,7 +255,7 @@ Test(povray, a_missing_image_file_is_named)
                     "plane { z, 1 pigment { image_map { png \"nofile.png\" } } }\n");
     fixture fx;
     l2p_error err = {0};
-    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_FAILED);
+    cr_assert_eq(render_one_chunk(&fx, dir, scene, &err), L2P_BAD_INPUT);
     char *expected = fmt("%s:4: %s", scene, "Cannot find file 'nofile.png'");
     cr_expect(strncmp(err.text, expected, strlen(expected)) == 0, "%s", err.text);
     free(expected);
@@ -348,7 +348,7 @@ Test(povray, a_failure_stops_the_other_processes)
     o.povray = script;
     /* The failing chunk waits until the sleeper has written its pid. */
     l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 2, &o, &err), L2P_FAILED);
+    cr_assert_eq(povray_render_chunks(fx.chunk, 2, &o, &err), L2P_BAD_INPUT);
     cr_expect_str_eq(err.text, "/x/y.pov:7: broken");
     FILE *f = fopen(pidfile, "r");
     cr_assert_not_null(f, "the sleeper never started");
@@ -616,7 +616,7 @@ Test(povray, an_error_in_a_later_frame_fails_with_its_message)
     make_chunks(&fx, dir, 2, (const int[]){1, 1});
     povray_options o = options(scene, dir, 1);
     l2p_error err = {0};
-    cr_assert_eq(povray_render_sequences(fx.chunk, (const int[]){2}, 1, &o, &err), L2P_FAILED);
+    cr_assert_eq(povray_render_sequences(fx.chunk, (const int[]){2}, 1, &o, &err), L2P_BAD_INPUT);
     char *expected = fmt("%s:3: Parse halted by #error directive: this scene renders once%s",
                          scene, "");
     cr_expect_str_eq(err.text, expected);

@@ -381,7 +381,7 @@ static void expect_nothing_left(const char *tmp, const char *dir, const char *ou
                  "files left beside the scene: %s", listing);
 }
 
-/* Runs a scene that POV-Ray rejects: exit 1, nothing written, nothing left in TMPDIR or beside
+/* Runs a scene that POV-Ray rejects: exit 2 (bad input), nothing written, nothing left in TMPDIR or beside
    the scene; returns stderr. */
 static char *render_bad_scene(const char *dir, const char *scene)
 {
@@ -390,7 +390,7 @@ static char *render_bad_scene(const char *dir, const char *scene)
     char *errtext;
     const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "32", "--height",
                        "24", "--spp", "2", PLACE, "--quiet", "-o", out);
-    cr_expect_eq(st, 1, "exit status %d for a scene with a syntax error: %s", st, errtext);
+    cr_expect_eq(st, 2, "exit status %d for a scene with a syntax error: %s", st, errtext);
     expect_nothing_left(tmp, dir, out, 1);
     return errtext;
 }
@@ -431,7 +431,7 @@ Test(render, failure_while_the_table_is_written_loses_nothing)
     const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "128", "--height",
                        "96", "--spp", "16", PLACE, "--jobs", "1", "--memory-mb", "1",
                        "--rays", csv, "--quiet", "-o", out);
-    cr_expect_eq(st, 1, "exit status %d: %s", st, errtext);
+    cr_expect_eq(st, 2, "exit status %d: %s", st, errtext);
     cr_expect_not_null(strstr(errtext, "pigmnt"), "POV-Ray's message is missing:\n%s", errtext);
     free(errtext);
     char *old = read_text(csv, NULL);

@@ -152,7 +152,7 @@ Test(scene_camera, other_directives_and_unknown_words_are_refused)
         {"camera { location <0, 1, -4> #if (1) orthographic #end }\n", "conditional", 2, 1},
         {"camera { location <0, 1, -4> #if (0) orthographic #end look_at 0 }\n", NULL, 0, 0},
         {"\ncamera\n{\n  #if (1)\n    angle 40\n  #else\n    angle 50\n  #end\n"
-         "  look_at Undeclared\n}\n", "Undeclared", 1, 9},
+         "  look_at Undeclared\n}\n", "Undeclared", 2, 9},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         char scene[512], out[512], where[600];
