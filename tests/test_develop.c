@@ -257,6 +257,26 @@ Test(develop, files_end_to_end)
     samplemap_free(&m);
 }
 
+/* One file given as two renders (the other's place taken) is refused before any is read: one
+   chunk would be developed twice and another never. */
+Test(develop, a_render_given_twice_is_refused)
+{
+    const char *dir = test_tmpdir();
+    samplemap m;
+    make_map(&m);
+    const char *a = tmp_path(dir, "a.exr"), *b = tmp_path(dir, "b.exr");
+    write_text(a, "not read");
+    write_text(b, "not read");
+    char via_dot[600];
+    snprintf(via_dot, sizeof via_dot, "%s/./a.exr", dir);
+    const char *renders[3] = {a, b, via_dot};
+    l2p_error err = {0, ""};
+    cr_assert_eq(develop_files(&m, renders, 3, tmp_path(dir, "out.png"), &err), L2P_BAD_INPUT);
+    cr_expect(strstr(err.text, "render 0 and as render 2"), "%s", err.text);
+    cr_expect_not(file_exists(tmp_path(dir, "out.png")));
+    samplemap_free(&m);
+}
+
 Test(develop, render_count_must_match_chunks)
 {
     samplemap m;

@@ -182,6 +182,14 @@ Test(field_files, the_map_is_checked)
     cr_assert_eq(field_map_read(path, &m, &err), L2P_BAD_INPUT);
     cr_expect(strstr(err.text, "field map"), "%s", err.text);
     bytes[9] = 'f';
+    bytes[18] = '9';   /* lens2pov-fieldmap 9: still a field map to develop, of another version */
+    write_bytes(path, bytes, length);
+    cr_expect(field_map_is_one(path));
+    char *errtext = NULL;
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "x.png"), (char *)NULL), 2);
+    cr_expect(errtext && strstr(errtext, "'lens2pov-fieldmap 1'"), "%s", errtext ? errtext : "");
+    free(errtext);
+    bytes[18] = '1';
     /* sub-image 0's dx, in the last table: its quadruple is 16 * spp bytes from the end */
     bytes[length - 16 * 3 + 4] = (char)0xff;
     bytes[length - 16 * 3 + 5] = (char)0xff;

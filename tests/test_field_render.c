@@ -89,7 +89,17 @@ Test(field_render, refuses_a_tolerance_it_cannot_keep)
     cr_expect_eq(L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--sampling",
                      "rays", "-o", tmp_path(dir, "x.png")), 2);
     free(errtext);
-    cr_expect(!file_exists(tmp_path(dir, "x.png")));
+    /* a tolerance that would change nothing: pixel sampling, asked for or trace's default */
+    errtext = NULL;
+    cr_expect_eq(L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--sampling", "pixel",
+                     "--field-tolerance", "0.1", "-o", tmp_path(dir, "x.png")), 2);
+    cr_expect(errtext && strstr(errtext, "--sampling field"), "%s", errtext ? errtext : "");
+    free(errtext);
+    errtext = NULL;
+    cr_expect_eq(L2P(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--field-tolerance", "0.1", "-o",
+                     tmp_path(dir, "t")), 2);
+    free(errtext);
+    cr_expect(!file_exists(tmp_path(dir, "x.png")) && !file_exists(tmp_path(dir, "t.map")));
 }
 
 /* render's default sampling is field; a film too small for the fields (the fisheye at 16x12:

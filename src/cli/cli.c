@@ -272,7 +272,7 @@ static int run_option(cli *c, const char *opt, const char *v, l2p_error *err)
     } else if (!strcmp(opt, "--field-tolerance")) {
         if (!value_double(v, &c->field_tolerance) || !(c->field_tolerance > 0))
             return value_bad(err, opt, "pixels above 0 (for exact rays: --sampling pixel)", v);
-        c->sampling_chosen = true;
+        c->sampling_chosen = c->tolerance_given = true;
     } else if (!strcmp(opt, "--what")) {   /* plot: the command checks the name */
         c->what = v;
         return L2P_OK;
@@ -335,6 +335,9 @@ static int check_contradictions(const cli *c, l2p_error *err)
     if (!isnan(o->aperture_diameter_mm) && !isnan(o->f_number))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--aperture-diameter and --f-number both set the aperture: give one");
+    if (c->tolerance_given && !c->field_sampling)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--field-tolerance is for --sampling field; "
+                        "pixel sampling traces every ray exactly");
     if (o->crop_x1 && (o->crop_x1 > o->width || o->crop_y1 > o->height))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--crop %d,%d,%d,%d reaches outside the %dx%d film (X1, Y1 exclusive)",

@@ -33,6 +33,7 @@ typedef struct cli {
     int povray_arg_count;
     bool field_sampling;         /* --sampling field (docs/fields.md); render's default */
     bool sampling_chosen;        /* --sampling or --field-tolerance given: render keeps to it */
+    bool tolerance_given;        /* --field-tolerance: refused with pixel sampling */
     double field_tolerance;      /* --field-tolerance, pixels [0.05] */
 } cli;
 

@@ -146,8 +146,11 @@ int field_develop(const field_map *m, const char *const *renders, int count, con
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "the field map has %d render%s but %d %s "
                         "given", m->renders, m->renders == 1 ? "" : "s", count,
                         count == 1 ? "was" : "were");
+    int st = develop_check_distinct(renders, count, err);
+    if (st)
+        return st;
     field_developer d;
-    int st = field_develop_start(&d, m, err);
+    st = field_develop_start(&d, m, err);
     if (st)
         return st;
     for (int r = 0; r < count && !st; r++)

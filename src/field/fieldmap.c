@@ -145,10 +145,11 @@ int field_map_finish(const outfile *f, const field_map *m, l2p_error *err)
 
 int field_map_is_one(const char *path)
 {
-    char first[sizeof MAGIC];
+    /* by the first word, whatever the version: reading it then says which version it takes */
+    static const char word[] = "lens2pov-fieldmap ";
+    char first[sizeof word - 1];
     FILE *f = fopen(path, "rb");
-    const int one = f && fread(first, 1, sizeof first, f) == sizeof first &&
-                    !memcmp(first, MAGIC, sizeof MAGIC - 1) && first[sizeof MAGIC - 1] == '\n';
+    const int one = f && fread(first, 1, sizeof first, f) == sizeof first && !memcmp(first, word, sizeof first);
     if (f)
         fclose(f);
     return one;

@@ -39,7 +39,8 @@ int field_map_put_weights(const outfile *f, const samplemap_header *h, int k, co
                           l2p_error *err);
 int field_map_finish(const outfile *f, const field_map *m, l2p_error *err);
 
-/* Whether path starts with the field map's first line (develop tells the two maps apart). */
+/* Whether path starts with the field map's first word, any version (develop tells the two
+   maps apart; field_map_read then refuses a version it does not read). */
 int field_map_is_one(const char *path);
 
 int field_map_read(const char *path, field_map *out, l2p_error *err);

@@ -1,9 +1,11 @@
 #include "image/develop.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "image/image_io.h"
 #include "optics/spectrum.h"
 
@@ -213,6 +215,26 @@ int develop_write_picture(const samplemap *map, const double *sums, const char *
     return st;
 }
 
+/* Whether paths a and b name one file: the same device and inode, or the same text when
+   either is missing (then reading it reports that). */
+static bool same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (stat(a, &sa) != 0 || stat(b, &sb) != 0)
+        return strcmp(a, b) == 0;
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+int develop_check_distinct(const char *const *renders, int render_count, l2p_error *err)
+{
+    for (int i = 0; i < render_count; i++)
+        for (int j = 0; j < i; j++)
+            if (same_file(renders[i], renders[j]))
+                return l2p_fail(err, L2P_BAD_INPUT, renders[i], 0, "given as render %d and as "
+                                "render %d: each render is developed once, in its place", j, i);
+    return L2P_OK;
+}
+
 int develop_files(const samplemap *map, const char *const *renders, int render_count,
                   const char *out_path, l2p_error *err)
 {
@@ -223,11 +245,13 @@ int develop_files(const samplemap *map, const char *const *renders, int render_c
                         "the sample map has %lld chunk%s but %d render%s given", chunks,
                         chunks == 1 ? "" : "s", render_count,
                         render_count == 1 ? " was" : "s were");
+    int st = develop_check_distinct(renders, render_count, err);
+    if (st)
+        return st;
     double *sums = calloc(develop_sums_per_pixel(h) * (size_t)crop_width(h) * (size_t)crop_height(h),
                           sizeof *sums);
     if (!sums)
         return l2p_fail(err, L2P_FAILED, out_path, 0, "out of memory");
-    int st = L2P_OK;
     for (int k = 0; k < render_count && !st; k++)
         st = develop_one(map, k, renders[k], sums, err);
     if (!st)

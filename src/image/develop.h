@@ -32,6 +32,10 @@ void develop_finish(const samplemap *map, const double *sums, float *rgb);
 int develop_write_picture(const samplemap *map, const double *sums, const char *out_path,
                           l2p_error *err);
 
+/* L2P_BAD_INPUT, naming it, when one file is given as two of the renders (one would be
+   developed twice and another never); else L2P_OK. */
+int develop_check_distinct(const char *const *renders, int render_count, l2p_error *err);
+
 /* The whole develop step: reads every chunk's render, accumulates, writes out_path with the
    lens, f-number, focus distance, film distance, film diagonal and spp as metadata. renders[k]
    is chunk k's render; render_count must be samplemap_chunk_count (else L2P_BAD_INPUT). The
