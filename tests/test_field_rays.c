@@ -225,7 +225,7 @@ Test(field_rays, a_failed_render_leaves_the_previous_csv)
     int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "16", "--height", "12",
                  "--spp", "2", "--location", "0,1,-4", "--look-at", "0,1,0", "--sampling", "field", "--rays", csv,
                  "--quiet", "-o", out);
-    cr_expect_eq(st, 1, "exit %d: %s", st, errtext ? errtext : "");
+    cr_expect_eq(st, 2, "exit %d: %s", st, errtext ? errtext : "");
     free(errtext);
     char *text = read_text(csv, NULL);
     cr_expect(text && !strcmp(text, "before\n"), "the CSV was replaced: %s", text ? text : "(gone)");

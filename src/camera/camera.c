@@ -423,13 +423,13 @@ void camera_trace_batch(const camera *c, sample_batch *s)
     const int n = s->n;
     trace_batch b;
     vec3 direction[CAMERA_BATCH];
-    /* runs of samples of one wavelength (all of a ray field's), each from its pupil */
+    /* runs of samples drawn from one pupil (with dispersion, of wavelengths near one another) */
     for (int k = 0, end; k < n; k = end) {
-        end = c->dispersion ? k + 1 : n;
-        while (end < n && s->wavelength_nm[end] == s->wavelength_nm[k])
+        const pupil *pu = c->dispersion ? camera_pupil_at(c, s->wavelength_nm[k]) : &c->pupil;
+        end = k + 1;
+        while (end < n && (!c->dispersion || camera_pupil_at(c, s->wavelength_nm[end]) == pu))
             end++;
-        pupil_film_rays(c->dispersion ? camera_pupil_at(c, s->wavelength_nm[k]) : &c->pupil, end - k,
-                        s->film_point + k, s->u + k, s->v + k, direction + k, s->weight + k);
+        pupil_film_rays(pu, end - k, s->film_point + k, s->u + k, s->v + k, direction + k, s->weight + k);
     }
     for (int k = 0; k < n; k++) {
         s->weight[k] *= c->weight_scale;
