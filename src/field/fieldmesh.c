@@ -120,6 +120,8 @@ static int larger_first(const void *pa, const void *pb)
 
 int field_mesh_sort_faces_by_area(field_mesh *m)
 {
+    if (m->faces < 2)
+        return 0;   /* nothing to order (and no array yet when there are no faces) */
     face_key *key = malloc(sizeof *key * (size_t)m->faces + 1);
     int (*tri)[3] = malloc(sizeof *tri * (size_t)m->faces + 1);
     if (!key || !tri) {
