@@ -166,6 +166,21 @@ Test(sizecheck, many_sub_images_of_a_tiny_film_stay_within_the_estimate)
     cr_expect_leq(peak, e.memory_bytes, "lens2pov took %.0f bytes", peak);
 }
 
+/* A render's picture is bounded by FIELD_PIXELS_PER_RENDER, not by the faces its sub-images
+   need at least (cells of 128 pixels, or none where the lens blocks everything): a 1920x1080
+   film at 256 spp (2048 x 2048 pixels a sub-image's render) is estimated at four sub-images a
+   POV-Ray picture, as field_render packs it, not seventy-four (12 GB a POV-Ray process). */
+Test(sizecheck, a_renders_picture_is_bounded_by_pixels)
+{
+    char *args[] = {"s.pov", LENS_DIR "telephoto.250mm.dat", "--width", "1920", "--height", "1080", "--spp",
+                    "256", "--sampling", "field", "--jobs", "2", "-o", "x.exr"};
+    const size_estimate e = estimate_of(args, sizeof args / sizeof args[0], 2);
+    const double picture = 4 * 2048.0 * 2048.0 * SIZE_POVRAY_BYTES_PER_PIXEL;
+    cr_log_info("a POV-Ray process: %.0f MB", e.povray_process_bytes / 1e6);
+    cr_expect_leq(e.povray_process_bytes, picture + 200e6, "%.0f bytes", e.povray_process_bytes);
+    cr_expect_geq(e.povray_process_bytes, picture, "%.0f bytes", e.povray_process_bytes);
+}
+
 /* The smallest power of two above n: POV-Ray's side of a render whose final side holds n. */
 static double render_side(int n)
 {

@@ -328,8 +328,8 @@ const pupil *camera_pupil_at(const camera *c, double nm)
     if (!c->spectral)
         return &c->pupil;
     const double t = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * (CAMERA_SPECTRAL_PUPILS - 1);
-    const int i = t > 0.0 ? (int)(t + 0.5) : 0;
-    return &c->spectral[i < CAMERA_SPECTRAL_PUPILS ? i : CAMERA_SPECTRAL_PUPILS - 1];
+    /* nearest, clamped before the conversion (NaN takes the first) */
+    return &c->spectral[t > 0.0 ? (int)(fmin(t, CAMERA_SPECTRAL_PUPILS - 1) + 0.5) : 0];
 }
 
 int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)

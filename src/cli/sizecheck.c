@@ -86,8 +86,7 @@ static double field_subimage_faces(const cli *c, int w, int h, double coarsest)
 }
 
 /* field_render packs consecutive sub-images into a render up to FIELD_FACES_PER_RENDER faces
-   and at most spp / jobs (rounded up), at least one; no sub-image whose pixels all pass has
-   fewer faces than the coarsest grid's two a cell, which bounds how many share a render. Its
+   and FIELD_PIXELS_PER_RENDER pixels, and at most spp / jobs (rounded up), at least one. Its
    picture, 2^a x 2^b, is never larger than its sub-images' own renders' pictures together;
    every later render has the first one's size. */
 static field_layout field_layout_of(const cli *c, int jobs)
@@ -100,7 +99,7 @@ static field_layout field_layout_of(const cli *c, int jobs)
     const double most = ceil(l.spp / (jobs > 0 ? jobs : 1));
     l.subimage_faces = field_subimage_faces(c, w, h, coarsest);
     l.subimage_pixels = (field_render_size(w) + 1.0) * (field_render_size(h) + 1.0);
-    const double fit = fmax(1.0, floor(FIELD_FACES_PER_RENDER / coarsest));
+    const double fit = fmax(1.0, floor(FIELD_PIXELS_PER_RENDER / l.subimage_pixels));
     l.render_faces = fmin(most * l.subimage_faces, fmax(FIELD_FACES_PER_RENDER, l.subimage_faces));
     l.render_pixels = fmin(most, fit) * l.subimage_pixels;
     l.at_once = fmin(jobs > 0 ? jobs : 1, l.spp);

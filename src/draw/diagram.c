@@ -39,7 +39,7 @@ int diagram_ray_points(const camera *c, double film_y, double v, vec3 *points, b
     *passed = false;
     /* The same film ray camera_trace sends, then the full simulation one surface at a time,
        which crosses the surfaces exactly as trace_toward_scene over the whole lens does. */
-    if (!(pupil_film_ray(&c->pupil, r.o, 0.5, v, &r.d) > 0.0))
+    if (!(pupil_film_ray(camera_pupil_at(c, WAVELENGTH_D_NM), r.o, 0.5, v, &r.d) > 0.0))
         return n;
     for (int i = l->count - 1; i >= 0; i--) {
         int blocked;

@@ -72,8 +72,8 @@ static void *build_worker(void *arg)
                           "use a larger tolerance or --sampling pixel", j->tol->pixels,
                           s->stats.faces, pixels, k);
         const bool too_fine = st == L2P_BAD_INPUT;   /* the two refusals above */
-        if (!st && field_mesh_shrink(&s->mesh) < 0)   /* kept until the renders are written */
-            st = l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
+        if (!st)
+            field_mesh_shrink(&s->mesh);   /* kept until the renders are written */
         if (!st)   /* into the map now: spp of them in memory would be spp pictures */
             st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
         free(s->weights);
@@ -170,7 +170,8 @@ static double cost_per_sub(int n, int nx, int w, int h, double faces_per_sub, in
 
 /* How many renders: as many as the count of sub-images a render costs least with (of the
    counts that have a grid, that an equal share for every job allows and whose first
-   sub-images stay within FIELD_FACES_PER_RENDER); at least as many as all the faces need at
+   sub-images stay within FIELD_FACES_PER_RENDER and FIELD_PIXELS_PER_RENDER); at least as
+   many as all the faces need at
    FIELD_FACES_PER_RENDER a render; a multiple of the jobs, so that the jobs get equal
    shares. */
 static int render_count(const sub *subs, int spp, int w, int h, int jobs, long long all,
@@ -186,6 +187,11 @@ static int render_count(const sub *subs, int spp, int w, int h, int jobs, long l
         if (n > 1 && (faces > FIELD_FACES_PER_RENDER || n > most))
             break;
         const int nx = grid_of(n, w, h);
+        int rw, rh;
+        if (nx)
+            grid_size(n, nx, w, h, &rw, &rh);
+        if (n > 1 && nx && (rw + 1.0) * (rh + 1.0) > FIELD_PIXELS_PER_RENDER)
+            break;
         const double cost = nx ? cost_per_sub(n, nx, w, h, faces_per_sub, jobs, frame_s) : INFINITY;
         if (cost < least)
             least = cost, count = n;

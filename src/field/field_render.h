@@ -45,6 +45,11 @@ typedef struct field_render_options {
    POV-Ray's per-pixel face search grows with the faces in a UV grid cell. */
 enum { FIELD_FACES_PER_RENDER = 20000 };
 
+/* A render's picture holds at most this many pixels, or one sub-image's render: about 670 MB
+   of POV-Ray at its 40 bytes a pixel. Sub-images of few faces (a gentle field, or none where
+   the lens blocks everything) would otherwise be packed by the dozen into one picture. */
+#define FIELD_PIXELS_PER_RENDER 16777216.0
+
 /* trace --sampling field: the map and the renders' includes and inis, for POV-Ray and
    `develop` to take from there (docs/fields.md). */
 typedef struct field_trace_options {

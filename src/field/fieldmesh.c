@@ -61,24 +61,26 @@ int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double x, double y)
     return k;
 }
 
-/* realloc to n elements of size, n at least 1; false only when it fails */
-static bool fit(void **p, int n, size_t size)
+/* An array of at least n elements of size cut to n: a failed realloc leaves the block as it
+   was, larger, which is as good. */
+static void fit(void **p, int n, size_t size)
 {
-    void *q = realloc(*p, (size_t)(n > 0 ? n : 1) * size);
+    void *q = *p && n > 0 ? realloc(*p, (size_t)n * size) : NULL;
     if (q)
         *p = q;
-    return q != NULL;
 }
 
-int field_mesh_shrink(field_mesh *m)
+void field_mesh_shrink(field_mesh *m)
 {
-    if (!fit((void **)&m->pos, m->vertices, sizeof *m->pos) || !fit((void **)&m->nrm, m->vertices, sizeof *m->nrm) ||
-        !fit((void **)&m->pix, m->vertices, sizeof *m->pix) || !fit((void **)&m->uv, m->vertices, sizeof *m->uv) ||
-        !fit((void **)&m->tri, m->faces, sizeof *m->tri))
-        return -1;
-    m->vertex_cap = m->vertices > 0 ? m->vertices : 1;
-    m->face_cap = m->faces > 0 ? m->faces : 1;
-    return 0;
+    fit((void **)&m->pos, m->vertices, sizeof *m->pos);
+    fit((void **)&m->nrm, m->vertices, sizeof *m->nrm);
+    fit((void **)&m->pix, m->vertices, sizeof *m->pix);
+    fit((void **)&m->uv, m->vertices, sizeof *m->uv);
+    fit((void **)&m->tri, m->faces, sizeof *m->tri);
+    if (m->pos)
+        m->vertex_cap = m->vertices;
+    if (m->tri)
+        m->face_cap = m->faces;
 }
 
 int field_mesh_face(field_mesh *m, int a, int b, int c)
@@ -164,9 +166,9 @@ int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, c
     fprintf(out, "#if (version < 3.7)\n  #declare Lens2pov_Version = version;\n  #version 3.7;\n#end\n");
     if (m->faces == 0) {
         /* A render none of whose pixels the lens passes (POV-Ray refuses a mesh without
-           faces): one face of zero area, in space and in UV, with equal normals. Every
-           pixel's UV weights in it are 0/0, so POV-Ray takes it for none, as povuv_mesh_find
-           does: all pixels black, alpha 0. */
+           vertices): one face of zero area, in space and in UV, with equal normals. POV-Ray
+           drops it when parsing, and kept, its UV weights would be 0/0 at every pixel (as
+           povuv_mesh_find computes them): no pixel is traced, all black, alpha 0. */
         fprintf(out, "#declare %s = mesh2 {\n  vertex_vectors { 3, <0,0,0>, <0,0,0>, <0,0,0> }\n"
                      "  normal_vectors { 3, <0,0,1>, <0,0,1>, <0,0,1> }\n"
                      "  uv_vectors { 3, <0,0>, <0,0>, <0,0> }\n  face_indices { 1, <0,1,2> }\n", name);

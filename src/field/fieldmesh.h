@@ -28,9 +28,8 @@ void field_mesh_clear(field_mesh *m);   /* no vertices, no faces; keeps the memo
    of memory. */
 int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double x, double y);
 
-/* Its arrays cut to what it holds (a mesh kept until its render is written takes no more).
-   Returns -1 when out of memory, the mesh unchanged. */
-int field_mesh_shrink(field_mesh *m);
+/* Its arrays cut to what it holds (a mesh kept until its render is written takes no more). */
+void field_mesh_shrink(field_mesh *m);
 
 /* Appends src moved by (dx, dy) pixels, its UVs recomputed for m's render. With both
    renders' sizes plus one powers of two, the UV barycentric weights of every pixel are the

@@ -160,7 +160,8 @@ static int explain_failure(const run *r, job *j, int status, l2p_error *err)
     const povray_log_names names = {r->opts->scene_path, r->scene_real_dir,
                                     {wrapper, r->chunks[job_chunk(r, j)].include_path},
                                     r->links, r->link_count};
-    int st = povray_log_error(j->log_path, &names, err);
+    /* a process killed (out of memory, say) is not the scene's fault, whatever its log says */
+    int st = WIFSIGNALED(status) ? 0 : povray_log_error(j->log_path, &names, err);
     free(wrapper);
     if (st)
         return st;

@@ -207,12 +207,14 @@ static int report_messages(const povray_log_names *names, const message *m, int 
         return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: %s", text);
     char file[4096];
     unlink_name(names, m[best].file, file, sizeof file);
-    /* a place in the user's files: the scene is bad input, as a bad lens file is */
+    /* a parse error, or a possible one that stopped the render (a missing image file), is
+       the scene's: bad input, as a bad lens file is */
+    const int status = m[best].rank >= 2 ? L2P_BAD_INPUT : L2P_FAILED;
     if (is_own_file(names, file))
-        return l2p_fail(err, L2P_BAD_INPUT, names->scene, 0,
+        return l2p_fail(err, status, names->scene, 0,
                         "the scene ends inside an unclosed block or #if (POV-Ray, reading on: %s)",
                         text);
-    return l2p_fail(err, L2P_BAD_INPUT, file, m[best].line, "%s", text);
+    return l2p_fail(err, status, file, m[best].line, "%s", text);
 }
 
 int povray_log_error(const char *log_path, const povray_log_names *names, l2p_error *err)

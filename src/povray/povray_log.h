@@ -20,8 +20,8 @@ typedef struct povray_log_names {
 } povray_log_names;
 
 /* The reason in the log at log_path, as "FILE:LINE: message" in err with the user's paths:
-   L2P_BAD_INPUT when it names a place in the user's files, else L2P_FAILED; 0 when the log
-   gives none. In an animation, only the last frame's messages
+   L2P_BAD_INPUT for a parse error or a possible one (the scene's), else L2P_FAILED; 0 when
+   the log gives none. In an animation, only the last frame's messages
    count. */
 int povray_log_error(const char *log_path, const povray_log_names *names, l2p_error *err);
 

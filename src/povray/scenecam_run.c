@@ -316,7 +316,7 @@ static int run_copy(const char *scene, const char *dir, const char *work, int w,
             st = L2P_BAD_INPUT;
         if (st < 0) {
             probe_error(scene, dir, top, copy, log, sc, err);
-            st = L2P_FAILED;
+            st = err->status;
         }
     }
     size_t n = 0;
