@@ -91,12 +91,10 @@ static const char *next_ray(const char *p, drawn_ray *r)
 
 /* Each drawn ray starts on the film at its film point, crosses every surface and leaves the
    front surface where camera_trace's ray (the one trace writes) starts, then goes on along it. */
-Test(diagram, the_rays_drawn_are_the_traced_rays)
+/* Every drawn ray against camera_trace from the same film point and pupil sample: blocked or
+   not, and where it leaves the front and in which direction; the number that pass. */
+static int check_drawn_rays(const char *svg, const camera *c)
 {
-    const char *dir = test_tmpdir();
-    char *svg = diagram_of("dgauss.50mm", dir);
-    camera c;
-    test_camera(&c, "dgauss.50mm", NULL);
     drawn_ray r;
     int passed = 0, field = 0;
     for (const char *p = svg; (p = next_ray(p, &r));) {
@@ -104,15 +102,15 @@ Test(diagram, the_rays_drawn_are_the_traced_rays)
         cr_assert_eq(r.y[0], r.film_y);
         ray out;
         double w;
-        const bool ok = camera_trace(&c, v3(0, r.film_y, 0), 0.5, r.v, &out, &w);
+        const bool ok = camera_trace(c, v3(0, r.film_y, 0), 0.5, r.v, &out, &w);
         cr_assert_eq(ok, !r.blocked, "film y %g, v %g", r.film_y, r.v);
         if (!ok)
             continue;
         passed++;
         field += r.film_y > 0.0;
-        cr_assert_eq(r.n, c.lens.count + 2, "film, every surface, beyond");
+        cr_assert_eq(r.n, c->lens.count + 2, "film, every surface, beyond");
         cr_assert(fabs(out.o.x) < 1e-9, "a meridional ray");
-        const int front = c.lens.count;
+        const int front = c->lens.count;
         cr_assert(fabs(r.z[front] - out.o.z) < 1e-6 && fabs(r.y[front] - out.o.y) < 1e-6,
                   "film y %g, v %g: drawn (%.9g, %.9g), traced (%.9g, %.9g)", r.film_y, r.v,
                   r.z[front], r.y[front], out.o.z, out.o.y);
@@ -120,8 +118,40 @@ Test(diagram, the_rays_drawn_are_the_traced_rays)
         cr_assert(fabs(dz * out.d.y - dy * out.d.z) < 1e-6 * hypot(dz, dy) && dz * out.d.z + dy * out.d.y > 0,
                   "the last segment follows the outgoing ray");
     }
-    cr_assert_eq(passed, 14, "two fans of 7 rays pass the double-Gauss");
-    cr_assert_eq(field, 7);
+    return passed * 100 + field;
+}
+
+Test(diagram, the_rays_drawn_are_the_traced_rays)
+{
+    const char *dir = test_tmpdir();
+    char *svg = diagram_of("dgauss.50mm", dir);
+    camera c;
+    test_camera(&c, "dgauss.50mm", NULL);
+    const int counts = check_drawn_rays(svg, &c);
+    cr_assert_eq(counts / 100, 14, "two fans of 7 rays pass the double-Gauss");
+    cr_assert_eq(counts % 100, 7);
+    camera_free(&c);
+    free(svg);
+}
+
+/* Through a 0.2 mm stop the triplet's samples come from spectral pupils (dispersion is on for
+   a lens with Abbe numbers), and the diagram draws from the one camera_trace uses at the d
+   line: drawn from the pupil for the whole spectrum, most of its rays were blocked. */
+Test(diagram, the_rays_drawn_through_a_small_stop_are_the_traced_rays)
+{
+    const char *dir = test_tmpdir();
+    const char *path = tmp_path(dir, "lens.svg");
+    run_lens2pov_ok("diagram", "diagram", "cooke-triplet.50mm", "--aperture-diameter", "0.2", "-o", path, NULL);
+    char *svg = read_text(path, NULL);
+    cr_assert(svg, "no %s", path);
+    camera_options o;
+    camera_options_default(&o);
+    o.aperture_diameter_mm = 0.2;
+    camera c;
+    test_camera(&c, "cooke-triplet.50mm", &o);
+    cr_assert(c.spectral, "spectral pupils through a 0.2 mm stop");
+    const int counts = check_drawn_rays(svg, &c);
+    cr_expect_geq(counts / 100, 10, "%d of 14 rays pass", counts / 100);
     camera_free(&c);
     free(svg);
 }
