@@ -260,27 +260,26 @@ static double spectral_nm(int i)
     return SPECTRUM_MIN_NM + i * (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) / (CAMERA_SPECTRAL_PUPILS - 1);
 }
 
-/* The largest ratio, over the film's radius, of the area of pupil b's region to that of a's:
-   the same pupil before and after pupil_cover. */
+/* The ratio of the area of pupil b's region to that of a's (the same pupil after and before
+   pupil_cover), over the film: each node weighted by its radius, as the film's area is. A
+   region grown only near the reach, where it is small and few film points lie, counts little. */
 static double grown_area(const pupil *a, const pupil *b)
 {
-    double most = 1.0;
-    for (double r = 0.0; r <= a->node_spacing_mm * PUPIL_NODES; r += a->node_spacing_mm) {
+    double sa = 0.0, sb = 0.0;
+    for (int j = 0; j <= PUPIL_NODES; j++) {
+        const double r = j * a->node_spacing_mm;
         pupil_shape ea, eb;
         if (!pupil_shape_at(a, r, &ea) || !pupil_shape_at(b, r, &eb))
             continue;
-        double sa = 0.0, sb = 0.0;
         for (int i = 0; i <= PUPIL_KNOTS; i++)
-            sa += ea.radius_mm[i] * ea.radius_mm[i], sb += eb.radius_mm[i] * eb.radius_mm[i];
-        if (sa > 0.0)
-            most = fmax(most, sb / sa);
+            sa += r * ea.radius_mm[i] * ea.radius_mm[i], sb += r * eb.radius_mm[i] * eb.radius_mm[i];
     }
-    return most;
+    return sa > 0.0 ? sb / sa : 1.0;
 }
 
 /* Spectral pupils are fitted when covering the spectrum grows the region more than this: a
    sample then passes less than two times in three as often as with a region for its own
-   wavelength, and the fits (a few tenths of a second) are worth it. */
+   wavelength, and the fits (half a second) are worth it. */
 #define SPECTRAL_WORTH 1.5
 
 /* With dispersion the pupil fitted at the d line also covers the two ends of the spectrum
