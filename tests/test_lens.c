@@ -456,6 +456,77 @@ Test(lens, byte_order_mark)
     lens_free(&l);
 }
 
+/* ---- surfaces that cross --------------------------------------------------------------- */
+
+/* The textbook sag R - sqrt(R^2 - rho^2), toward the film for R > 0: an independent form of
+   the gap between two neighbouring surfaces at height rho. */
+static double textbook_gap(double r1, double t, double r2, double rho)
+{
+    const double s1 = r1 - copysign(sqrt(r1 * r1 - rho * rho), r1);
+    const double s2 = r2 - copysign(sqrt(r2 * r2 - rho * rho), r2);
+    return t - s1 + s2;
+}
+
+Test(lens, crossing_surfaces_are_found_at_the_rim)
+{
+    /* A biconvex element too thin for its aperture: its faces meet 1.2 mm from the axis, well
+       inside the 12 mm rim. */
+    lens l = parsed("0 1 0 6\n62.8 0.1 1.5 24\n-45.7 40 1 24\n");
+    double rho = 0.0, gap = 0.0;
+    cr_assert_eq(lens_crossing(&l, &rho, &gap), 1);
+    cr_assert_eq(rho, 12.0);
+    cr_assert_float_eq(gap, textbook_gap(62.8, 0.1, -45.7, 12.0), 1e-12);
+    cr_assert(gap < -2.6, "gap %g", gap);
+    lens_free(&l);
+    /* A meniscus whose back is flatter than its front (the gap falls with the height). */
+    l = parsed("10 0.5 1.5 16\n20 1 1 16\n0 5 0 4\n");
+    cr_assert_eq(lens_crossing(&l, &rho, &gap), 0);
+    cr_assert_float_eq(gap, textbook_gap(10, 0.5, 20, 8.0), 1e-12);
+    lens_free(&l);
+    /* Thick enough by a micrometre at the rim: no crossing. */
+    const double edge = -textbook_gap(62.8, 0.0, -45.7, 12.0) + 1e-3;
+    char text[128];
+    snprintf(text, sizeof text, "0 1 0 6\n62.8 %.9f 1.5 24\n-45.7 40 1 24\n", edge);
+    l = parsed(text);
+    cr_assert_eq(lens_crossing(&l, &rho, &gap), -1);
+    lens_free(&l);
+    l = parsed(FRONT STOP REAR);
+    cr_assert_eq(lens_crossing(&l, &rho, &gap), -1);
+    lens_free(&l);
+}
+
+Test(lens, no_shipped_lens_crosses_and_a_crossing_one_is_traced_with_a_warning)
+{
+    char path[512], dir[64];
+    static const char *const names[] = {
+        "cooke-triplet.50mm", "dgauss.50mm", "fisheye-dx.10.5mm", "fisheye.10mm", "macro.105mm",
+        "petzval.50mm", "portrait.85mm", "retrofocus.28mm", "retrofocus.35mm", "sonnar.180mm",
+        "sonnar.50mm", "takumar.135mm", "takumar.50mm", "telephoto.250mm", "tessar.100mm",
+        "wide.22mm", "zoom.200mm", "zoom.80mm"};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+        snprintf(path, sizeof path, "%s/lenses/%s.dat", LENS2POV_SOURCE_DIR, names[k]);
+        lens l;
+        l2p_error err = {0};
+        cr_assert_eq(lens_read(path, &l, &err), L2P_OK, "%s", err.text);
+        double rho, gap;
+        cr_expect_eq(lens_crossing(&l, &rho, &gap), -1, "%s: %g mm at %g mm", names[k], gap, rho);
+        lens_free(&l);
+    }
+    temp_dir(dir);
+    snprintf(path, sizeof path, "%s/thin.dat", dir);
+    write_text(path, "# too thin\n0 1 0 6\n62.8 0.1 1.5 24\n-45.7 40 1 24\n");
+    char *out = NULL, *errout = NULL;
+    cr_assert_eq(run_lens2pov(&out, &errout, "info", path, NULL), 0, "%s", errout);
+    char where[600];
+    snprintf(where, sizeof where, "lens2pov: warning: %s:3: ", path);
+    cr_expect(errout && strncmp(errout, where, strlen(where)) == 0, "%s", errout);
+    cr_expect(errout && strstr(errout, "(line 4) cross"), "%s", errout);
+    free(out);
+    free(errout);
+    unlink(path);
+    rmdir(dir);
+}
+
 Test(lens, stop_index_zero_means_air)
 {
     lens l = parsed(FRONT STOP REAR);

@@ -145,6 +145,41 @@ ParameterizedTest(library_lens *l, library, info_gives_the_claimed_focal_length)
     free(errtext);
 }
 
+/* info's working f-number against first-order optics: the exit pupil stands m_p f in front of
+   the rear focal point (m_p = D_XP / D_EP) and the film x' = film distance - BFD behind it, so
+   N_w = (m_p f + x') / (m_p D_EP) = N (1 + x' / (m_p f)): N itself at infinity focus. Four
+   lenses of different kinds, at infinity and at 12 focal lengths. */
+Test(library, the_working_f_number_follows_the_focus)
+{
+    static const char *const names[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm", "telephoto.250mm"};
+    static const double efl_mm[] = {50.358, 22.0, 10.0, 250.0};   /* near enough: a distance */
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+        char path[512], distance[64];
+        snprintf(path, sizeof path, "%s/%s.dat", LENS_DIR, names[k]);
+        snprintf(distance, sizeof distance, "%.9g", 12.0 * efl_mm[k]);
+        const char *const at[] = {"inf", distance};
+        for (int i = 0; i < 2; i++) {
+            char *out = NULL, *errtext = NULL;
+            cr_assert_eq(run_lens2pov(&out, &errtext, "info", path, "--json", "--unit-mm", "1",
+                                      "--focus-distance", at[i], "--f-number", "8", NULL), 0,
+                         "%s", errtext);
+            const double f = json_number(out, "efl_mm"), bfd = json_number(out, "bfd_mm");
+            const double m_p = json_number(out, "exit_pupil_diameter_mm") /
+                               json_number(out, "entrance_pupil_diameter_mm");
+            const double n = json_number(out, "aperture_f_number");
+            const double x = json_number(out, "film_distance_mm") - bfd;
+            const double expected = n * (1.0 + x / (m_p * f));
+            const double got = json_number(out, "working_f_number");
+            cr_expect_leq(fabs(got / expected - 1.0), 1e-6, "%s at %s: N_w %.9g, expected %.9g",
+                          names[k], at[i], got, expected);
+            cr_expect(i == 1 || fabs(got / n - 1.0) < 1e-6, "%s at infinity: %g, N %g", names[k], got, n);
+            cr_expect(i == 0 || got > n * 1.05, "%s: %g at about 1:11, N %g", names[k], got, n);
+            free(out);
+            free(errtext);
+        }
+    }
+}
+
 /* trace at infinity focus (the default look-at is closer than the telephoto focuses). */
 ParameterizedTestParameters(library, traces)
 {

@@ -749,6 +749,11 @@ static const stab_case CASES[] = {
     {.name = "focus-too-close", .what = "focus closer than the lens allows", .lens = lens_dgauss,
      .args = "--focus-distance 0.05",
      .refusal = "closer than this lens can focus: the closest is "},
+    /* Without --focus-distance the look-at point sets it, and the refusal says so. */
+    {.name = "look-at-too-close", .what = "look-at point closer than the lens focuses",
+     .lens = lens_dgauss, .args = "--look-at 0,0,0.05",
+     .refusal = "the look-at point, 0.05 away, is closer than this lens can focus (the closest "
+                "is "},
     {.name = "afocal-rear-near",
      .what = "nearly afocal subsystem behind the stop (stop-image pupil)",
      .lens = lens_afocal_rear_near, .args = "--focus-distance 3", .pass_min = 0.05,
@@ -831,6 +836,7 @@ STAB_TEST(aperture_1um, "aperture-1um")
 STAB_TEST(focus_at_infinity, "focus-inf")
 STAB_TEST(focus_at_the_closest_distance, "focus-closest")
 STAB_TEST(focus_closer_than_possible_is_refused, "focus-too-close")
+STAB_TEST(look_at_closer_than_possible_is_refused, "look-at-too-close")
 STAB_TEST(nearly_afocal_subsystem_behind_the_stop, "afocal-rear-near")
 STAB_TEST(afocal_whole_lens_is_refused, "afocal-whole")
 STAB_TEST(nearly_afocal_whole_lens_is_refused, "afocal-whole-near")

@@ -138,7 +138,7 @@ static int setup_focus(camera *c, const camera_options *o, l2p_error *err)
             units = v3_length(v3_sub(o->look_at, o->location));
         if (!(units > 0.0))
             return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--focus-distance must be positive");
-        int st = focus_set(l, units * o->unit_mm, o->unit_mm, err);
+        int st = focus_set(l, units * o->unit_mm, o->unit_mm, isnan(o->focus_distance_units), err);
         if (!st)
             st = check_film_position(l, false, units * o->unit_mm, err);
         if (st)
@@ -243,16 +243,37 @@ static int setup_dispersion(camera *c, const camera_options *o, l2p_error *err)
     return L2P_OK;
 }
 
+/* The lens at wavelength nm, a copy of l. */
+static int copy_at(lens *at, const lens *l, double nm, l2p_error *err)
+{
+    if (lens_copy(at, l))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    lens_at_wavelength(at, nm);
+    return L2P_OK;
+}
+
 /* Covers pupil p for the lens at wavelength nm (pupil_cover). */
 static int cover_at(pupil *p, const lens *l, double nm, l2p_error *err)
 {
     lens at;
-    if (lens_copy(&at, l))
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    lens_at_wavelength(&at, nm);
-    pupil_cover(p, &at);
-    lens_free(&at);
-    return L2P_OK;
+    int st = copy_at(&at, l, nm, err);
+    if (!st) {
+        pupil_cover(p, &at);
+        lens_free(&at);
+    }
+    return st;
+}
+
+/* Fits pupil p to the lens at wavelength nm over the film's reach (pupil_fit). */
+static int fit_at(pupil *p, const lens *l, double nm, double reach_mm, l2p_error *err)
+{
+    lens at;
+    int st = copy_at(&at, l, nm, err);
+    if (!st) {
+        pupil_fit(p, &at, reach_mm);
+        lens_free(&at);
+    }
+    return st;
 }
 
 static double spectral_nm(int i)
@@ -305,16 +326,9 @@ static int cover_spectrum(camera *c, l2p_error *err)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int i = 0; i < CAMERA_SPECTRAL_PUPILS && !st; i++) {
         pupil *p = &c->spectral[i];
-        lens at;
         *p = c->pupil;
-        if (lens_copy(&at, &c->lens)) {
-            st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-            break;
-        }
-        lens_at_wavelength(&at, spectral_nm(i));
-        pupil_fit(p, &at, 0.5 * c->film.diagonal_mm);
-        lens_free(&at);
-        if (i > 0)
+        st = fit_at(p, &c->lens, spectral_nm(i), 0.5 * c->film.diagonal_mm, err);
+        if (!st && i > 0)
             st = cover_at(p, &c->lens, spectral_nm(i - 1), err);
         if (!st && i + 1 < CAMERA_SPECTRAL_PUPILS)
             st = cover_at(p, &c->lens, spectral_nm(i + 1), err);

@@ -65,6 +65,19 @@ double info_half_field_deg(const camera *c, vec3 p)
     return acos(fmin(1.0, r.d.z)) * 180.0 / M_PI;
 }
 
+/* The image-side f-number at the focus in effect, N_w = 1 / (2 n' sin theta'), paraxially
+   the exit pupil's height above the film over its diameter (the film at z = 0, in air): at
+   infinity focus the f-number itself, nearer N (1 + |m| / m_p), m the magnification and m_p
+   the pupil magnification (Smith, Modern Optical Engineering, 4th ed., sec. 6.4). */
+double info_working_f_number(const camera *c)
+{
+    double z, r;
+    l2p_error ignored;
+    if (pupil_stop_image(&c->lens, true, &z, &r, &ignored) || !(r > 0.0))
+        return NAN;
+    return z / (2.0 * r);
+}
+
 typedef struct field { const char *key, *label, *unit; double value; } field;
 
 static void print_fields(FILE *out, const field *f, int n, bool json)
@@ -103,7 +116,8 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,
         field more[] = {
             {"film_distance_mm", "film distance", "mm", c->lens.film_distance_mm},
             {"focus_distance", "focus distance (film to subject)", "units", c->focus_distance_units},
-            {"working_f_number", "f-number (this aperture)", "", c->f_number},
+            {"aperture_f_number", "f-number (this aperture)", "", c->f_number},
+            {"working_f_number", "working f-number (paraxial)", "", info_working_f_number(c)},
             {"aperture_diameter_mm", "aperture diameter", "mm", c->lens.stop_diameter_mm},
             {"hfov_deg", "horizontal field of view", "deg", 2 * info_half_field_deg(c, v3(0.5 * fi->width_mm, 0, 0))},
             {"vfov_deg", "vertical field of view", "deg", 2 * info_half_field_deg(c, v3(0, 0.5 * fi->height_mm, 0))},

@@ -21,6 +21,10 @@ int lens_info_of(const lens *l, lens_info *out, l2p_error *err);
    when even the centre's ray is blocked. */
 double info_half_field_deg(const camera *c, vec3 p);
 
+/* The working (image-side) f-number at the camera's focus and aperture, paraxial; NAN when the
+   stop has no image. */
+double info_working_f_number(const camera *c);
+
 /* Prints them, and the camera's focus and field of view when c is not NULL; the wavelength
    first when it is not NAN (the lens was taken to it). */
 void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,

@@ -54,6 +54,19 @@ int lens_lookup(const char *name, char **path, l2p_error *err)
     return *path ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
 }
 
+/* A lens whose surfaces cross cannot be made, but its rays can be traced (each surface is met
+   in the file's order): a warning, not a refusal. */
+static void warn_crossing(const lens *l)
+{
+    double rho, gap;
+    const int i = lens_crossing(l, &rho, &gap);
+    if (i >= 0)
+        fprintf(stderr, "lens2pov: warning: %s:%d: this surface and the next (line %d) cross "
+                "inside their clear apertures: %.4g mm from the axis the next stands %.4g mm in "
+                "front of it; the rays are traced as if they did not\n", l->path,
+                l->surface[i].line, l->surface[i + 1].line, rho, -gap);
+}
+
 int lens_read_named(const char *name, lens *l, l2p_error *err)
 {
     char *path;
@@ -62,5 +75,7 @@ int lens_read_named(const char *name, lens *l, l2p_error *err)
         return st;
     st = lens_read(path, l, err);
     free(path);
+    if (!st)
+        warn_crossing(l);
     return st;
 }

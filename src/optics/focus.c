@@ -45,7 +45,8 @@ int focus_check_real_image(const lens *l, const thick_lens *t, l2p_error *err)
 /* Newton's x x' = f1 f2 with the lens at film distance d: x = D - (F1_0 + d),
    x' = F2_0 + d. With e = x' and S = D - F1_0 + F2_0: e^2 - S e + f1 f2 = 0, whose smaller
    root e = 2 f1 f2 / (S + sqrt(S^2 - 4 f1 f2)) keeps the film near the rear focal plane. */
-static int thick_estimate(lens *l, double object_mm, double unit_mm, double *d, l2p_error *err)
+static int thick_estimate(lens *l, double object_mm, double unit_mm, bool from_look_at, double *d,
+                          l2p_error *err)
 {
     lens_set_film_distance(l, 0.0);
     thick_lens t;
@@ -59,21 +60,28 @@ static int thick_estimate(lens *l, double object_mm, double unit_mm, double *d, 
     if (!isinf(object_mm)) {
         const double S = object_mm - t.f1_z_mm + t.f2_z_mm;
         const double disc = S * S - 4.0 * ff;
-        if (!(S > 0.0) || !(disc >= 0.0))
-            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
-                            "focus distance %g is closer than this lens can focus: the closest "
-                            "is %.6g (film plane to subject, scene units)", object_mm / unit_mm,
-                            (2.0 * sqrt(ff) + t.f1_z_mm - t.f2_z_mm) / unit_mm);
+        if (!(S > 0.0) || !(disc >= 0.0)) {
+            const double closest = (2.0 * sqrt(ff) + t.f1_z_mm - t.f2_z_mm) / unit_mm;
+            return from_look_at
+                       ? l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "the look-at point, %g away, is "
+                                  "closer than this lens can focus (the closest is %.6g, film "
+                                  "plane to subject, scene units): give --focus-distance, or "
+                                  "look at something farther", object_mm / unit_mm, closest)
+                       : l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "focus distance %g is closer "
+                                  "than this lens can focus: the closest is %.6g (film plane to "
+                                  "subject, scene units)", object_mm / unit_mm, closest);
+        }
         e = 2.0 * ff / (S + sqrt(disc));
     }
     *d = e - t.f2_z_mm;
     return L2P_OK;
 }
 
-int focus_set(lens *l, double object_distance_mm, double unit_mm, l2p_error *err)
+int focus_set(lens *l, double object_distance_mm, double unit_mm, bool from_look_at,
+              l2p_error *err)
 {
     double d = 0.0;
-    int st = thick_estimate(l, object_distance_mm, unit_mm, &d, err);
+    int st = thick_estimate(l, object_distance_mm, unit_mm, from_look_at, &d, err);
     if (st)
         return st;
     /* Moving the lens by delta moves a distant object's image by about delta, so the first

@@ -10,8 +10,10 @@
    for infinity) is in paraxial focus on the film: a thick-lens estimate, refined by secant
    steps on the axial crossing of a real near-axial ray until it lies on the film. unit_mm
    only words messages in scene units. L2P_BAD_INPUT, naming the closest distance, when the
-   plane is closer than the lens can focus. */
-int focus_set(lens *l, double object_distance_mm, double unit_mm, l2p_error *err);
+   plane is closer than the lens can focus; from_look_at words it for a distance that was not
+   asked for but came from the look-at point. */
+int focus_set(lens *l, double object_distance_mm, double unit_mm, bool from_look_at,
+              l2p_error *err);
 
 /* A lens that diverges light (t: its thick lens, film distance 0) forms no real image:
    L2P_BAD_INPUT naming the file. Every command refuses such a lens, info as trace. */

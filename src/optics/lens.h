@@ -123,4 +123,9 @@ double lens_total_length_mm(const lens *l);
    toward the scene (+z). 0 for the stop. */
 double lens_sag_mm(const lens_surface *s, double rho_mm);
 
+/* The first two neighbouring surfaces that cross inside both clear apertures: at the smaller
+   semi-aperture rho the rear one stands in front of the front one. Returns the index i of the
+   front one (surfaces i and i + 1), with rho and the axial gap there (< 0), or -1. */
+int lens_crossing(const lens *l, double *rho_mm, double *gap_mm);
+
 #endif

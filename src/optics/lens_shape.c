@@ -89,6 +89,27 @@ double lens_sag_mm(const lens_surface *s, double rho_mm)
     return -c_rho2 / (1.0 + sqrt(root));
 }
 
+/* Surface i's vertex stands thickness_i in front of surface i + 1's; at height rho their
+   points are s_i(rho) and s_i+1(rho) from those vertices, so the glass or air between them is
+   gap(rho) = thickness_i + s_i(rho) - s_i+1(rho) thick there. Since ds/drho =
+   -c rho / sqrt(1 - c^2 rho^2) falls as c grows, gap' has the sign of c_i+1 - c_i at every
+   height: the gap is least on the axis (thickness_i >= 0) or at the rim of the smaller
+   aperture, and the rim alone need be checked. */
+int lens_crossing(const lens *l, double *rho_mm, double *gap_mm)
+{
+    for (int i = 0; i + 1 < l->count; i++) {
+        const lens_surface *a = &l->surface[i], *b = &l->surface[i + 1];
+        const double rho = 0.5 * fmin(a->aperture_diameter_mm, b->aperture_diameter_mm);
+        const double gap = a->thickness_mm + lens_sag_mm(a, rho) - lens_sag_mm(b, rho);
+        if (gap < -1e-9 * (a->thickness_mm + rho)) {
+            *rho_mm = rho;
+            *gap_mm = gap;
+            return i;
+        }
+    }
+    return -1;
+}
+
 /* Edge k joins the corners at rotation + 2 pi k / N and rotation + 2 pi (k + 1) / N: its
    outward normal points halfway between them, at distance R cos(pi / N) from the centre. */
 void lens_set_blades(lens *l, int count, double rotation_rad)
