@@ -7,6 +7,9 @@
    0.5 s for each lens2pov process (loading OpenImageIO) and 0.7 s for each POV-Ray process.
    No .timeout (see test_povray.c: it leaks under AddressSanitizer with --jobs 2). */
 #include <criterion/criterion.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -495,6 +498,52 @@ Test(render, missing_scene_or_lens_is_bad_input)
     remove_tree(dir);
 }
 
+/* An animation's output in a folder that does not exist is refused for what it is, not by the
+   disk check: the check once compared the free space of a folder it could not measure. */
+Test(render, an_animation_into_a_missing_folder_is_refused_by_name)
+{
+    NEW_DIR(dir);
+    PATH(scene, dir, "there.pov");
+    PATH(out, dir, "nodir/x.png");
+    write_text(scene, MODERN "background { rgb 1 }\n");
+    char *errtext;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "8", "--height", "6",
+                       "--spp", "1", PLACE, "--quiet", "-o", out, "--", "+KFI1", "+KFF2");
+    cr_expect_eq(st, 2, "exit status %d: %s", st, errtext);
+    cr_expect_not_null(strstr(errtext, "nodir/x1.png: cannot write"), "%s", errtext);
+    cr_expect_null(strstr(errtext, "bytes"), "%s", errtext);
+    free(errtext);
+    remove_tree(dir);
+}
+
+/* A --keep-temp folder another render holds (its lock, taken here) is refused: the two would
+   write and remove each other's files. Once free, the same folder is taken. */
+Test(render, a_kept_folder_in_use_is_refused)
+{
+    NEW_DIR(dir);
+    PATH(scene, dir, "there.pov");
+    PATH(keep, dir, "work");
+    PATH(out, dir, "out.png");
+    write_text(scene, MODERN "background { rgb 1 }\n");
+    cr_assert_eq(mkdir(keep, 0777), 0);
+    const int fd = open(keep, O_RDONLY | O_DIRECTORY);
+    cr_assert(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0);
+    char *errtext;
+    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "8", "--height", "6",
+                 "--spp", "1", PLACE, "--keep-temp", keep, "--quiet", "-o", out);
+    cr_expect_eq(st, 2, "exit status %d: %s", st, errtext);
+    cr_expect_not_null(strstr(errtext, "another lens2pov render is using this --keep-temp "
+                                       "folder"), "%s", errtext);
+    cr_expect_not(exists(out), "an output was written");
+    free(errtext);
+    close(fd);
+    st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "8", "--height", "6", "--spp",
+             "1", PLACE, "--keep-temp", keep, "--quiet", "-o", out);
+    cr_expect_eq(st, 0, "exit status %d: %s", st, errtext);
+    free(errtext);
+    remove_tree(dir);
+}
+
 /* ---------------------------------------------------------------- crops and chunks */
 
 /* --crop renders only its region, with the samples the whole film would use there: the same
@@ -582,6 +631,36 @@ Test(render, chunks_and_jobs_do_not_change_the_picture)
     cr_expect_eq(differ, 0, "%d values differ between 1 chunk and %d chunks", differ, chunks);
     free(a.p);
     free(b.p);
+    remove_tree(dir);
+}
+
+/* A crop set in an ini the user gives after `--` is overridden, not obeyed: every render's own
+   ini (after the user's on POV-Ray's command line) sets all four bounds, in both samplings. */
+Test(render, a_crop_in_the_users_ini_changes_nothing)
+{
+    NEW_DIR(dir);
+    PATH(scene, dir, "smooth.pov");
+    PATH(ini, dir, "crop.ini");
+    PATH(plain, dir, "plain.exr");
+    PATH(cropped, dir, "cropped.exr");
+    write_text(scene, SMOOTH_SCENE);
+    write_text(ini, "Start_Row=0.5\nStart_Column=0.5\nEnd_Row=0.9\nEnd_Column=0.8\n");
+    static const char *const samplings[] = {"pixel", "field"};
+    for (int k = 0; k < 2; k++) {
+        run_lens2pov_ok("no ini", "render", scene, DGAUSS, "--sampling", samplings[k], "--width",
+                        "32", "--height", "24", "--spp", "4", PLACE, "--quiet", "-o", plain, NULL);
+        run_lens2pov_ok("a crop in an ini", "render", scene, DGAUSS, "--sampling", samplings[k],
+                        "--width", "32", "--height", "24", "--spp", "4", PLACE, "--quiet", "-o",
+                        cropped, "--", ini, NULL);
+        image a = load(plain), b = load(cropped);
+        cr_assert(a.w == b.w && a.h == b.h && a.w == 32 && a.h == 24);
+        int differ = 0;
+        for (size_t i = 0; i < 4 * (size_t)a.w * (size_t)a.h; i++)
+            differ += a.p[i] != b.p[i];
+        cr_expect_eq(differ, 0, "%s sampling: %d values differ", samplings[k], differ);
+        free(a.p);
+        free(b.p);
+    }
     remove_tree(dir);
 }
 

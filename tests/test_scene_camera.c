@@ -132,6 +132,89 @@ Test(scene_camera, conditionals_inside_the_camera_block)
                              "  right x * image_width / image_height\n}\n");
 }
 
+/* A '#' alone before the block's '}' (Debian's scenes/language/image_size.pov has one):
+   POV-Ray passes over it, and so does the scene camera's reader. */
+Test(scene_camera, a_lone_hash_before_the_blocks_end_is_passed_over)
+{
+    expect_markers_as_povray(MARKERS_HEAD
+                             "camera {\n  location Lift(Eye)\n  look_at Target\n  angle 40\n"
+                             "  right x * image_width / image_height #\n}\n");
+}
+
+/* A camera item POV-Ray evaluates to nan (its clock in an animation of one frame) is the
+   scene's fault: exit 2, naming the item, the statement's line and the clock. */
+Test(scene_camera, a_camera_that_evaluates_to_nan_is_refused)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], out[512];
+    snprintf(scene, sizeof scene, "%s/anim.pov", dir);
+    snprintf(out, sizeof out, "%s/a.png", dir);
+    write_text(scene, "#version 3.7;\nsphere { 0, 1 pigment { rgb 1 } }\n"
+                      "camera { location <clock, 0, -5>\n look_at 0 }\n");
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o",
+                       out, "--", "+KFI3", "+KFF3");
+    cr_expect_eq(st, 2, "exit %d: %s", st, errtext);
+    char where[600];
+    snprintf(where, sizeof where, "lens2pov: %s:3: the camera's location is not a finite number",
+             scene);
+    cr_expect(errtext && strncmp(errtext, where, strlen(where)) == 0, "%s", errtext);
+    cr_expect(errtext && strstr(errtext, "clock"), "%s", errtext);
+    free(errtext);
+}
+
+/* The probe's POV-Ray run, failing with "Timed out waiting for worker thread startup" (a
+   loaded machine), is started again as a render's runs are: a stand-in that fails so on its
+   first start only gives the scene's camera on the second, with a warning. */
+Test(scene_camera, a_probe_that_times_out_starting_is_run_again)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], script[512], starts[512], prefix[512];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(script, sizeof script, "%s/slowpov", dir);
+    snprintf(starts, sizeof starts, "%s/starts", dir);
+    snprintf(prefix, sizeof prefix, "%s/t", dir);
+    write_text(scene, MARKERS_HEAD CAMERA("x"));
+    char text[2048];
+    snprintf(text, sizeof text, "#!/bin/sh\necho x >> '%s'\nif [ $(wc -l < '%s') -lt 2 ]; then\n"
+             "  echo 'Timed out waiting for worker thread startup' >&2; exit 1\nfi\n"
+             "exec povray \"$@\"\n", starts, starts);
+    write_text(script, text);
+    chmod(script, 0755);
+    setenv("LENS2POV_POVRAY", script, 1);
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "trace", DGAUSS, "--scene", scene, SIZE, "--spp", "1",
+                       "-o", prefix);
+    unsetenv("LENS2POV_POVRAY");
+    cr_expect_eq(st, 0, "exit %d: %s", st, errtext);
+    cr_expect(errtext && strstr(errtext, "timed out starting its threads"), "%s", errtext);
+    char *count = read_text(starts, NULL);
+    cr_expect(count && !strcmp(count, "x\nx\n"), "starts: %s", count ? count : "none");
+    free(count);
+    free(errtext);
+}
+
+/* An #include of a file that cannot be found may hold a camera: POV-Ray is asked, and its
+   error is the answer (exit 2, the scene's line), not the default camera, whose 67 degrees
+   the double-Gauss cannot reach. */
+Test(scene_camera, a_missing_include_is_reported_not_taken_for_no_camera)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], out[512];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(out, sizeof out, "%s/a.png", dir);
+    write_text(scene, "#version 3.7;\n#include \"mycam.inc\"\nPlaceCam(<0, 1, -5>)\n");
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "--angle",
+                       "scene", "-q", "-o", out);
+    cr_expect_eq(st, 2, "exit %d: %s", st, errtext);
+    char where[600];
+    snprintf(where, sizeof where, "lens2pov: %s:2: ", scene);
+    cr_expect(errtext && strncmp(errtext, where, strlen(where)) == 0, "%s", errtext);
+    cr_expect(errtext && strstr(errtext, "mycam.inc"), "%s", errtext);
+    free(errtext);
+}
+
 /* Any other directive inside the block, a conditional that does not stand between items (in
    an expression, or before a word that is no item), a type chosen by a conditional that runs,
    or a word that is no camera item is refused naming the statement's line (exit 2); a type in

@@ -84,6 +84,11 @@ run 0 "trace --sampling field with dispersion, 24x18x3" trace \
     -o "$work/f" --quiet
 printf '50 5 1.5 20\n0 5 0 10\n-50 0 1\n' >"$work/bad.dat"
 run 2 "trace of a malformed lens" trace "$work/bad.dat" -o "$work/b" --quiet
+# The disk check once read the free space of a folder it could not measure (refused before
+# POV-Ray runs or the image library loads).
+printf 'background { rgb 1 }\n' >"$work/plain.pov"
+run 2 "render of an animation into a missing folder" render "$work/plain.pov" "$lens" \
+    --width 8 --height 6 --spp 1 --look-at 0,0,3 -o "$work/nodir/a.png" --quiet -- +KFI1 +KFF2
 [ "$all" = 1 ] && run 2 "trace with a bad option" trace "$lens" --aperture-diameter 99 -o "$work/b" --quiet
 
 # The probe: develop loads the image library, which then refuses a file that is not an image.

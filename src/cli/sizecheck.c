@@ -212,7 +212,11 @@ static int check_disk(const cli *c, const disk_need *needs, int n, l2p_error *er
     for (int i = 0; i < n && i < 8; i++) {
         folder[i] = folder_for(needs[i].path, needs[i].is_dir);
         total[i] = 0.0;
-        if (!folder[i] || !free_bytes(folder[i], &have[i], &dev[i]))
+        if (folder[i] && !free_bytes(folder[i], &have[i], &dev[i])) {
+            free(folder[i]);   /* not there (yet): whatever writes to it says so */
+            folder[i] = NULL;
+        }
+        if (!folder[i])
             continue;
         for (int k = 0; k <= i; k++)   /* summed into the first need on the same device */
             if (folder[k] && dev[k] == dev[i]) {

@@ -3,9 +3,11 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include "base/cleanup.h"
@@ -35,14 +37,34 @@ static void remove_stale_workspaces(const char *tmp)
     closedir(d);
 }
 
+/* Two renders in one kept folder would write, and remove, each other's files: the folder is
+   locked (flock, released when the process ends however it ends). */
+static int lock_kept(workspace *w, l2p_error *err)
+{
+    w->lock_fd = open(w->dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (w->lock_fd < 0)
+        return l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "cannot open folder: %s", strerror(errno));
+    if (flock(w->lock_fd, LOCK_EX | LOCK_NB) != 0) {
+        const int e = errno;
+        close(w->lock_fd);
+        w->lock_fd = -1;
+        return e == EWOULDBLOCK
+                   ? l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "another lens2pov render is using "
+                              "this --keep-temp folder: give each render its own")
+                   : l2p_fail(err, L2P_FAILED, w->dir, 0, "cannot lock folder: %s", strerror(e));
+    }
+    return L2P_OK;
+}
+
 int workspace_make(workspace *w, const char *keep, l2p_error *err)
 {
     w->keep = keep != NULL;
+    w->lock_fd = -1;
     if (w->keep) {
         snprintf(w->dir, sizeof w->dir, "%s", keep);
         if (mkdir(w->dir, 0777) != 0 && errno != EEXIST)
             return l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "cannot make folder: %s", strerror(errno));
-        return L2P_OK;
+        return lock_kept(w, err);
     }
     const char *tmp = temp_root();
     remove_stale_workspaces(tmp);
@@ -56,8 +78,11 @@ int workspace_make(workspace *w, const char *keep, l2p_error *err)
 
 void workspace_remove(const workspace *w)
 {
-    if (w->keep)
+    if (w->keep) {
+        if (w->lock_fd >= 0)
+            close(w->lock_fd);   /* the lock goes with it */
         return;
+    }
     DIR *d = opendir(w->dir);
     if (d) {
         char path[8192];

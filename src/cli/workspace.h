@@ -9,13 +9,16 @@
 typedef struct workspace {
     char dir[4096];
     bool keep;                 /* --keep-temp's folder: left in place */
+    int lock_fd;               /* the kept folder, locked while this render uses it; else -1 */
 } workspace;
 
-/* keep (--keep-temp), made when missing; else a new lens2pov.PID.XXXXXX in the temporary
+/* keep (--keep-temp), made when missing and locked (L2P_BAD_INPUT when another render holds
+   it: the two would write the same files); else a new lens2pov.PID.XXXXXX in the temporary
    folder, removed on a signal too, after removing those of processes that are gone. */
 int workspace_make(workspace *w, const char *keep, l2p_error *err);
 
-/* Removes the workspace and its files (nothing in it has folders), unless it is kept. */
+/* Removes the workspace and its files (nothing in it has folders), unless it is kept; a kept
+   one is unlocked. */
 void workspace_remove(const workspace *w);
 
 #endif

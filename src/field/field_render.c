@@ -72,10 +72,11 @@ static void *build_worker(void *arg)
                           "use a larger tolerance or --sampling pixel", j->tol->pixels,
                           s->stats.faces, pixels, k);
         const bool too_fine = st == L2P_BAD_INPUT;   /* the two refusals above */
-        if (!st)
+        if (!st) {
             field_mesh_shrink(&s->mesh);   /* kept until the renders are written */
-        if (!st)   /* into the map now: spp of them in memory would be spp pictures */
+            /* into the map now: spp of them in memory would be spp pictures */
             st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
+        }
         free(s->weights);
         s->weights = NULL;
         if (st) {
@@ -341,7 +342,8 @@ static int write_ini(const field_render_plan *p, const char *exr, outfile *f, l2
     }
     const char *q = povray_ini_needs_quotes(path) ? "\"" : "";
     fprintf(f->fp, "; lens2pov: a ray-field render, final pixel (x, y) at image pixel (x, y + 1)\n"
-                   "Width=%d\nHeight=%d\nStart_Row=2\nEnd_Row=%d\nEnd_Column=%d\nAntialias=Off\n"
+                   "Width=%d\nHeight=%d\nStart_Row=2\nEnd_Row=%d\nStart_Column=0.0\n"
+                   "End_Column=%d\nAntialias=Off\n"
                    "Output_File_Type=E\nOutput_To_File=On\nOutput_File_Name=%s%s%s\nDisplay=Off\n",
             p->width + 1, p->height + 1, p->used_height + 1, p->used_width, q, path, q);
     free(path);

@@ -2,7 +2,6 @@
 #include "field/fieldmesh.h"
 
 #include <math.h>
-#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 

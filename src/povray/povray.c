@@ -28,9 +28,7 @@
 enum {
     TICK_MS = 20,
     DRAW_EVERY_TICKS = 12,     /* redraw the bar 4 times a second */
-    STOP_WAIT_TICKS = 250,     /* SIGTERM, then 5 s, then SIGKILL */
-    TRANSIENT_RETRIES = 5,     /* starts again of a chunk that failed for a passing cause, */
-    TRANSIENT_PAUSE_MS = 100   /* the first after this pause, each next after twice the last */
+    STOP_WAIT_TICKS = 250      /* SIGTERM, then 5 s, then SIGKILL */
 };
 
 /* ---------------------------------------------------------------- processes */
@@ -229,19 +227,14 @@ static void draw_progress(run *r, int finished)
 
 /* ---------------------------------------------------------------- the scheduler */
 
-/* A run that failed for a passing cause (povray_log_transient) is started again, at most
-   TRANSIENT_RETRIES times a task, with a warning. The pauses between starts grow (0.1 s to
-   1.6 s) because the cause is load: vfeSession::Initialize gives POV-Ray's worker thread 3 s
-   to start, and starts that fail come in runs. Returns whether it was started again. */
+/* A run that failed for a passing cause is started again (povray_retry_transient).
+   Returns whether it was. */
 static bool retried(run *r, job *j, int status, int *st, l2p_error *err)
 {
-    if (*st || (WIFEXITED(status) && WEXITSTATUS(status) == 0) || j->retries >= TRANSIENT_RETRIES ||
-        !povray_log_transient(j->log_path))
+    if (*st || (WIFEXITED(status) && WEXITSTATUS(status) == 0) ||
+        !povray_retry_transient(j->log_path, j->retries))
         return false;
-    fprintf(stderr, "lens2pov: warning: POV-Ray timed out starting its threads (a loaded "
-                    "machine); starting it again\n");
     const int retries = j->retries + 1;
-    sleep_ms(TRANSIENT_PAUSE_MS << j->retries);
     *st = start_job(r, j, j->task, err);
     j->retries = retries;
     return true;

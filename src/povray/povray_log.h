@@ -34,6 +34,11 @@ void povray_log_progress(const char *log_path, long long faces, double *parse, d
    start on a loaded machine): the run may be started again. */
 bool povray_log_transient(const char *log_path);
 
+/* Whether a run that failed, its log at log_path, is to be started again after retries_made
+   starts again: when it failed for that passing cause, at most seven times. It then warns on
+   stderr and pauses first (0.1 s, doubling with each retry). */
+bool povray_retry_transient(const char *log_path, int retries_made);
+
 /* The frame an animation's log is at ("Rendering frame F of N"), or frame when its tail
    names none. */
 int povray_log_frame(const char *log_path, int frame);

@@ -143,6 +143,19 @@ static bool read_numbers(const char *s, double *v, int count)
     return true;
 }
 
+/* An item message take_item cannot read: a value that is not finite is the scene's (POV-Ray's
+   clock is nan in a one-frame animation, +KFI3 +KFF3), anything else lens2pov's. */
+static int item_unreadable(const char *msg, const char *scene, int line, l2p_error *err)
+{
+    const char *value = strchr(msg, ' ');
+    if (value && (strstr(value, "nan") || strstr(value, "inf")))
+        return l2p_fail(err, L2P_BAD_INPUT, scene, line, "the camera's %.*s is not a finite "
+                        "number as POV-Ray evaluates it (%s); POV-Ray's clock, for one, is "
+                        "nan in an animation of one frame (+KFI3 +KFF3)", (int)(value - msg) - 9,
+                        msg + 9, value + 1);
+    return l2p_fail(err, L2P_FAILED, scene, line, "cannot read POV-Ray's value: %s", msg);
+}
+
 /* One item message into the camera; false when it cannot be read. The old syntax (before
    #version 3.5) applies each item at once, the new one at the end (finish_camera). */
 static bool take_item(pov_camera *c, const char *msg, const char *scene, int line, int *st,
@@ -331,7 +344,7 @@ int scene_camera_from_log(const char *log, size_t n, const scene_files *files,
     int st = L2P_OK;
     while (!st && next_message(log, n, &pos, buf, sizeof buf) && strcmp(buf, "lens2pov-end")) {
         if (!take_item(&c, buf, scene, line, &st, err) && !st)
-            st = l2p_fail(err, L2P_FAILED, scene, line, "cannot read POV-Ray's value: %s", buf);
+            st = item_unreadable(buf, scene, line, err);
     }
     if (!c.has_look_at)
         c.focus = v3_add(c.location, c.direction);   /* before the transforms */

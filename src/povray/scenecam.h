@@ -78,6 +78,8 @@ typedef struct scene_copy {
     char **path, **copy;       /* [k], k >= 1: an included file, as found, and its copy in
                                   work ([0] the scene, no copy) */
     int count;
+    bool unresolved;           /* an #include names a file not found as POV-Ray finds files:
+                                  only POV-Ray can say what it holds, or that it is missing */
 } scene_copy;
 int scene_copy_make(const char *scene, const char *text, size_t n, const char *work,
                     char *const *library, scene_copy *out, l2p_error *err);

@@ -172,8 +172,9 @@ static bool collect(const char *name, size_t len, int line, void *ctx)
         return true;
     }
     char path[4096 + NAME_MAX_BYTES + 8];
-    const int file = find_include(c, name, len, path, sizeof path)
-                         ? copy_of(c, path, s->depth + 1) : 0;
+    const bool found = find_include(c, name, len, path, sizeof path);
+    c->out->unresolved = c->out->unresolved || !found;
+    const int file = found ? copy_of(c, path, s->depth + 1) : 0;
     if (file > 0 && s->count == s->cap) {
         swap *grown = realloc(s->swap, (size_t)(s->cap = 2 * s->cap + 8) * sizeof *grown);
         if (!grown)

@@ -311,7 +311,11 @@ static int run_copy(const char *scene, const char *dir, const char *work, int w,
     snprintf(log, sizeof log, "%s/scene-camera.log", work);
     int st = write_probe_files(work, sc->text, copy, top, sizeof copy, err);
     if (!st) {
-        st = run_probe(dir, top, log, w, h, pa, err);
+        for (int retries = 0;; retries++) {   /* as a render's runs are started again */
+            st = run_probe(dir, top, log, w, h, pa, err);
+            if (st >= 0 || !povray_retry_transient(log, retries))
+                break;
+        }
         if (st < 0 && pa->user_count && refused_options(log, pa, err))
             st = L2P_BAD_INPUT;
         if (st < 0) {
@@ -353,7 +357,8 @@ static int probe(const char *scene, const char *dir, const char *work, int w, in
         free(text);
         return st;
     }
-    const bool own_text_only = sc.count == 1;   /* no included file has a camera */
+    /* no included file has a camera, and every one was found */
+    const bool own_text_only = sc.count == 1 && !sc.unresolved;
     if (own_text_only && pa->user_count == 0 && !strcmp(sc.text, text)) {
         st = one_default_frame(scene, out, err);   /* POV-Ray's default camera, one frame */
     } else {

@@ -94,8 +94,8 @@ static size_t paren_end(const char *s, size_t close, size_t i)
 
 /* Where a directive that may stand inside a camera block ends, '#' at s[a]: a conditional
    (#if (...), #else, #end, #switch, ...), copied as written, so that the #debug lines of the
-   items it holds run as the items would, or a #debug or #warning of a string. a for any other
-   directive. */
+   items it holds run as the items would, a #debug or #warning of a string, or a '#' alone at
+   the block's end. a for any other directive. */
 static size_t directive_end(const char *s, size_t close, size_t a)
 {
     static const char *const plain[] = {"else", "end", "break"};
@@ -104,6 +104,8 @@ static size_t directive_end(const char *s, size_t close, size_t a)
                                             "range"};
     const size_t w = lex_skip_blank(s, close, a + 1), we = w < close ? lex_token_end(s, close, w) : w;
     const size_t p = lex_skip_blank(s, close, we);
+    if (w >= close)
+        return a + 1;   /* a '#' alone before the block's '}': POV-Ray passes over it */
     for (size_t k = 0; k < sizeof plain / sizeof *plain; k++)
         if (lex_is_word(s, w, we, plain[k]))
             return we;
@@ -205,8 +207,10 @@ static void put_camera(lex_buf *t, const char *s, size_t kw, size_t open, size_t
         const size_t a = i, b = lex_token_end(s, close, i), mark = t->n;
         const enum lex_item kind = lex_item_kind(s, a, b);
         if (s[a] == '#') {   /* between items: directives_pass has passed it */
-            i = lex_skip_blank(s, close, directive_end(s, close, a));
-            put_expression(t, s, a, i);
+            const size_t e = directive_end(s, close, a);
+            i = lex_skip_blank(s, close, e);
+            if (e > a + 1)   /* not a lone '#' */
+                put_expression(t, s, a, i);
             lex_puts(t, " ");
             depth += nesting(s, close, a);
             items = true;

@@ -46,7 +46,9 @@ int chunk_ini_write(outfile *ini, const char *ini_path, const char *exr_path, in
         fprintf(ini->fp,
                 "; lens2pov: POV-Ray settings for the ray table beside this file.\n"
                 "; Row 0 of the image repeats row 1 (POV-Ray 3.7.0.10, FS#254): one row more.\n"
-                "Width=%d\nHeight=%lld\nAntialias=Off\nOutput_File_Type=E\nOutput_To_File=On\n"
+                "; The whole picture (fractions), whatever crop a user's ini before this one set.\n"
+                "Width=%d\nHeight=%lld\nStart_Row=0.0\nEnd_Row=1.0\nStart_Column=0.0\n"
+                "End_Column=1.0\nAntialias=Off\nOutput_File_Type=E\nOutput_To_File=On\n"
                 "Output_File_Name=%s%s%s\nDisplay=Off\n", width, height, quote, exr, quote);
     }
     free(exr);
