@@ -81,11 +81,11 @@ static void outline(int blades, double out[72])
     test_camera(&c, "dgauss.50mm", &o);
     memset(out, 0, 72 * sizeof *out);
     const double plane_mm = 20000.0;
-    for (int j = 0; j < 500; j++)
-        for (int i = 0; i < 500; i++) {
+    for (int j = 0; j < 250; j++)
+        for (int i = 0; i < 250; i++) {
             ray r;
             double w;
-            if (!camera_trace(&c, v3(0, 0, 0), (i + 0.5) / 500, (j + 0.5) / 500, &r, &w))
+            if (!camera_trace(&c, v3(0, 0, 0), (i + 0.5) / 250, (j + 0.5) / 250, &r, &w))
                 continue;
             const double t = (plane_mm - r.o.z) / r.d.z;
             const double x = r.o.x + t * r.d.x, y = r.o.y + t * r.d.y;
