@@ -23,6 +23,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "base/outfile.h"
+#include "image/image_io.h"
 #include "support.h"
 
 extern char **environ;
@@ -570,6 +571,55 @@ Test(robustness, sigint_during_render_keeps_the_previous_image_and_cleans_up)
     const char *first;
     cr_expect_eq(unexpected_files(dir, allowed, &first), 0, "left %s", first);
     remove_tree(dir);
+}
+
+/* An animation stopped midway keeps the frames it finished, as POV-Ray's own would: each frame
+   is developed as soon as its renders are in. A stand-in for POV-Ray renders frame 1 and
+   sleeps in frames 2 and 3 (the scene-camera probe, -F, runs as it is); once frame 1's
+   picture is there, SIGINT. Both samplings. */
+Test(robustness, an_animation_stopped_midway_keeps_its_finished_frames)
+{
+    static const char *const samplings[] = {"field", "pixel"};
+    for (int k = 0; k < 2; k++) {
+        const char *dir = test_tmpdir();
+        char scene[512], script[512], out[512], first[512], last[512];
+        snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+        snprintf(script, sizeof script, "%s/slowpov", dir);
+        snprintf(out, sizeof out, "%s/anim.png", dir);
+        snprintf(first, sizeof first, "%s/anim1.png", dir);
+        snprintf(last, sizeof last, "%s/anim3.png", dir);
+        write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                          "background { rgb 0.3 }\nsphere { <0, 0, 6>, 1 pigment { rgb 1 } "
+                          "finish { emission 1 } }\n");
+        write_text(script, "#!/bin/sh\ncase \" $* \" in *\" -F \"*|*\" +SF1 \"*) "
+                           "exec povray \"$@\";; esac\nexec sleep 60\n");
+        chmod(script, 0755);
+        setenv("LENS2POV_POVRAY", script, 1);
+        char *argv[] = {"render", scene, DGAUSS, "--width", "32", "--height", "24", "--spp",
+                        "4", "--sampling", (char *)samplings[k], "--look-at", "0,0,6", "-o", out,
+                        "--quiet", "--", "+KFI1", "+KFF3", NULL};
+        const pid_t pid = spawn_lens2pov(argv, dir);
+        unsetenv("LENS2POV_POVRAY");
+        for (int waited = 0; waited < 60000 && !has_file(dir, "anim1.png", 1); waited += 10)
+            sleep_ms(10);
+        cr_expect(has_file(dir, "anim1.png", 1), "%s: frame 1 never came", samplings[k]);
+        cr_assert_eq(kill(pid, SIGINT), 0);
+        int status = 0;
+        cr_assert_eq(waitpid(pid, &status, 0), pid);
+        cr_expect(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT, "status %#x", status);
+        int w = 0, h = 0;
+        float *px = NULL;
+        l2p_error e;
+        cr_expect_eq(image_read_rgba(first, &w, &h, &px, &e), 0, "%s: %s", samplings[k], e.text);
+        cr_expect(w == 32 && h == 24 && px && px[4 * (12 * 32 + 16)] > 0.5f,
+                  "%s: frame 1 is %dx%d, its centre %g", samplings[k], w, h, px ? px[4 * (12 * 32 + 16)] : -1.0);
+        free(px);
+        cr_expect(!file_exists(last), "%s: frame 3 was written", samplings[k]);
+        const char *const allowed[] = {"scene.pov", "slowpov", "anim1.png", NULL};
+        const char *left;
+        cr_expect_eq(unexpected_files(dir, allowed, &left), 0, "%s: left %s", samplings[k], left);
+        remove_tree(dir);
+    }
 }
 
 /* Temporary files are created exclusively under unpredictable names: symbolic links planted at

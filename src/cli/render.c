@@ -199,27 +199,60 @@ static povray_chunk *chunk_list(const writer *w, int count, long long faces,
     return pc;
 }
 
-/* Every frame's renders, one a chunk, developed into its picture through the writer's sample
-   map. */
-static int develop_frames(const writer *w, const povray_chunk *pc, int chunks,
-                          const table_frames *tf, l2p_error *err)
-{
-    const char **exrs = calloc((size_t)(chunks > 0 ? chunks : 1), sizeof *exrs);
-    if (!exrs)
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    char map_path[8300];
-    snprintf(map_path, sizeof map_path, "%s.map", w->prefix);
+/* The frames, each developed through the writer's sample map as soon as its chunks'
+   pictures are in (povray_options' picture_done, on the calling thread) once the writer is
+   done, since the map is complete only then: an animation stopped midway keeps the frames it
+   finished. Frames whose pictures came in before are developed at the end. */
+typedef struct frames_developing {
+    writer *w;
+    const povray_chunk *pc;
+    const table_frames *tf;
     samplemap map;
-    int st = samplemap_read(map_path, &map, err);
-    const bool read = st == L2P_OK;
-    for (int f = 0; !st && f < tf->count; f++) {
-        for (int i = 0; i < chunks; i++)
-            exrs[i] = pc[i * tf->count + f].output_exr;
-        st = develop_files(&map, exrs, chunks, tf->frame[f]->output, err);
+    bool have_map;
+    int *done;                 /* a frame's pictures in */
+    bool *developed;
+    const char **exrs;         /* a frame's pictures, one a chunk */
+} frames_developing;
+
+static int develop_frame(frames_developing *d, int f, int chunks, l2p_error *err)
+{
+    int st = image_io_ready(err);
+    if (!st && !d->have_map) {
+        char map_path[8300];
+        snprintf(map_path, sizeof map_path, "%s.map", d->w->prefix);
+        st = samplemap_read(map_path, &d->map, err);
+        d->have_map = st == L2P_OK;
     }
-    if (read)
-        samplemap_free(&map);
-    free(exrs);
+    for (int i = 0; !st && i < chunks; i++)
+        d->exrs[i] = d->pc[i * d->tf->count + f].output_exr;
+    if (!st)
+        st = develop_files(&d->map, d->exrs, chunks, d->tf->frame[f]->output, err);
+    d->developed[f] = st == L2P_OK;
+    return st;
+}
+
+/* The writer's chunks once it has written them all well, else -1. */
+static int chunks_written(writer *w)
+{
+    pthread_mutex_lock(&w->lock);
+    const int total = w->status ? -1 : w->total;
+    pthread_mutex_unlock(&w->lock);
+    return total;
+}
+
+static int frame_picture_done(void *ctx, int k, l2p_error *err)
+{
+    frames_developing *d = ctx;
+    const int f = k % d->tf->count, total = chunks_written(d->w);
+    return ++d->done[f] == total ? develop_frame(d, f, total, err) : L2P_OK;
+}
+
+static int develop_rest(frames_developing *d, l2p_error *err)
+{
+    int st = L2P_OK;
+    for (int f = 0; !st && f < d->tf->count; f++)
+        if (!d->developed[f])
+            st = develop_frame(d, f, d->w->total, err);
     return st;
 }
 
@@ -250,8 +283,8 @@ static int publish_csv(const char *from, outfile *out, l2p_error *err)
 }
 
 
-/* Writes one table and renders its chunks for each of its frames side by side, then develops
-   them. */
+/* Writes one table and renders its chunks for each of its frames side by side, developing
+   each frame as it comes in. */
 static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
                             outfile *csv, const table_frames *tf, int table, l2p_error *err)
 {
@@ -268,8 +301,15 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     const int chunk_jobs = (jobs + tf->count - 1) / tf->count;
     w.chunk_faces = chunk_faces_for(cam, c, chunk_jobs, &count);
     povray_chunk *pc = chunk_list(&w, count, w.chunk_faces, tf);
-    if (!pc)
+    frames_developing d = {.w = &w, .pc = pc, .tf = tf};
+    d.done = calloc((size_t)tf->count, sizeof *d.done);
+    d.developed = calloc((size_t)tf->count, sizeof *d.developed);
+    d.exrs = calloc((size_t)count + 1, sizeof *d.exrs);
+    if (!pc || !d.done || !d.developed || !d.exrs) {
+        free(d.done), free(d.developed), free(d.exrs);
+        free_chunk_list(pc, count * tf->count);
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
     pthread_mutex_init(&w.lock, NULL);
     pthread_t thread;
     int st = cleanup_start_thread(&thread, write_table, &w) == 0
@@ -283,7 +323,7 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
                                    !c->quiet, NULL, chunks_ready, &w, c->povray_args,
                                    c->povray_arg_count, c->cam.width, c->cam.height,
-                                   load_image_library, NULL, NULL, NULL};
+                                   load_image_library, NULL, frame_picture_done, &d};
         if (!st)
             st = povray_render_chunks(pc, count * tf->count, &po, err);
         if (st)
@@ -294,11 +334,14 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         if (!st)
             st = image_io_ready(err);
         if (!st)
-            st = develop_frames(&w, pc, w.total, tf, err);
+            st = develop_rest(&d, err);
         if (!st && c->rays_csv && table == 0)
             st = publish_csv(w.csv, csv, err);
     }
     pthread_mutex_destroy(&w.lock);
+    if (d.have_map)
+        samplemap_free(&d.map);
+    free(d.done), free(d.developed), free(d.exrs);
     free_chunk_list(pc, count * tf->count);
     return st;
 }

@@ -112,7 +112,9 @@ static void free_frame_chunks(povray_chunk *pc, int n)
     free(pc);
 }
 
-/* Render r of frame i is run k = r * frames + i: render-major, the largest renders first as
+/* Render r of frame i is run k = i * renders + r: frame-major, so that frames finish in turn
+   and each is developed as soon as its renders are in (an animation stopped midway keeps the
+   frames it finished, as POV-Ray's own would); within a frame the largest renders first, as
    packed. An animation frame's picture is named as POV-Ray names it (+O with the frame's
    number added). NULL out of memory. */
 static povray_chunk *frame_chunks(const field_files *f, const field_render_options *o)
@@ -120,8 +122,8 @@ static povray_chunk *frame_chunks(const field_files *f, const field_render_optio
     const int n = f->renders * o->frame_count;
     povray_chunk *pc = calloc((size_t)n + 1, sizeof *pc);
     for (int k = 0; pc && k < n; k++) {
-        const field_frame *fr = &o->frames[k % o->frame_count];
-        pc[k] = f->chunk[k / o->frame_count];
+        const field_frame *fr = &o->frames[k / f->renders];
+        pc[k] = f->chunk[k % f->renders];
         pc[k].placement = fr->placement;
         if (fr->number >= 0) {
             pc[k].frame = fr->number;
@@ -136,24 +138,52 @@ static povray_chunk *frame_chunks(const field_files *f, const field_render_optio
     return pc;
 }
 
-/* Frame i's pictures, one a render, developed from the map. */
-static int develop_frames(const field_files *f, const povray_chunk *pc,
-                          const field_render_options *o, l2p_error *err)
+/* The frames, each developed from the map once its renders are in (povray_options'
+   picture_done, on the calling thread). */
+typedef struct frames_developing {
+    const field_files *f;
+    const povray_chunk *pc;
+    const field_render_options *o;
+    field_map map;
+    int *done;                 /* a frame's renders in */
+    const char **exr;          /* a frame's pictures, one a render */
+} frames_developing;
+
+static int develop_frame(frames_developing *d, int i, l2p_error *err)
 {
-    field_map m;
-    int st = field_map_read(f->map_path, &m, err);
+    for (int r = 0; r < d->f->renders; r++)
+        d->exr[r] = d->pc[i * d->f->renders + r].output_exr;
+    const int st = image_io_ready(err);
+    return st ? st : field_develop(&d->map, d->exr, d->f->renders, d->o->frames[i].output, err);
+}
+
+static int frame_picture_done(void *ctx, int k, l2p_error *err)
+{
+    frames_developing *d = ctx;
+    const int i = k / d->f->renders;
+    return ++d->done[i] == d->f->renders ? develop_frame(d, i, err) : L2P_OK;
+}
+
+/* Every run of every frame (frame_chunks), each frame developed as it comes in. */
+static int render_frames(const field_files *f, const povray_chunk *pc,
+                         const field_render_options *o, const povray_options *po, l2p_error *err)
+{
+    frames_developing d = {.f = f, .pc = pc, .o = o};
+    int st = field_map_read(f->map_path, &d.map, err);
     if (st)
         return st;
-    const char **exr = malloc(sizeof *exr * ((size_t)f->renders + 1));
-    if (!exr)
+    d.done = calloc((size_t)o->frame_count, sizeof *d.done);
+    d.exr = malloc(sizeof *d.exr * ((size_t)f->renders + 1));
+    if (!d.done || !d.exr)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int i = 0; !st && i < o->frame_count; i++) {
-        for (int r = 0; r < f->renders; r++)
-            exr[r] = pc[r * o->frame_count + i].output_exr;
-        st = field_develop(&m, exr, f->renders, o->frames[i].output, err);
-    }
-    free(exr);
-    field_map_free(&m);
+    povray_options with_frames = *po;
+    with_frames.picture_done = frame_picture_done;
+    with_frames.picture_ctx = &d;
+    if (!st)
+        st = povray_render_chunks(pc, f->renders * o->frame_count, &with_frames, err);
+    free(d.done);
+    free(d.exr);
+    field_map_free(&d.map);
     return st;
 }
 
@@ -187,11 +217,7 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     if (!st && one_run_a_job)
         st = render_by_jobs(&f, o->jobs, &po, o->frames[0].output, err);
     else if (!st)
-        st = povray_render_chunks(pc, f.renders * o->frame_count, &po, err);
-    if (!st && !one_run_a_job)
-        st = image_io_ready(err);
-    if (!st && !one_run_a_job)
-        st = develop_frames(&f, pc, o, err);
+        st = render_frames(&f, pc, o, &po, err);
     free_frame_chunks(pc, f.renders * o->frame_count);
     field_files_free(&f);
     return st;
