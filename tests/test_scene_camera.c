@@ -215,6 +215,37 @@ Test(scene_camera, a_missing_include_is_reported_not_taken_for_no_camera)
     free(errtext);
 }
 
+/* A camera normal { } perturbs POV-Ray's rays, which no lens does: it is left out with a
+   warning naming the scene, whether the camera is read by POV-Ray (an expression) or as plain
+   numbers; a normal in a branch POV-Ray does not take, or none, gives no warning. */
+Test(scene_camera, a_camera_normal_is_left_out_with_a_warning)
+{
+    const char *dir = test_tmpdir();
+    static const char *const cameras[] = {
+        "camera { location <0, 1, -5> look_at <0, 1, 0> normal { bumps 0.5 scale 0.1 } }\n",
+        "camera { location <0, 1, -5> + 0 look_at <0, 1, 0> normal { bumps 0.5 scale 0.1 } }\n",
+        "camera { location <0, 1, -5> + 0 look_at <0, 1, 0>\n"
+        "#if (image_width < 2) normal { bumps 0.5 } #end }\n",
+        "camera { location <0, 1, -5> look_at <0, 1, 0> }\n"};
+    for (int k = 0; k < 4; k++) {
+        char scene[512], prefix[512], text[512];
+        snprintf(scene, sizeof scene, "%s/scene%d.pov", dir, k);
+        snprintf(prefix, sizeof prefix, "%s/t%d", dir, k);
+        snprintf(text, sizeof text, "#version 3.7;\n%s", cameras[k]);
+        write_text(scene, text);
+        char *errtext = NULL;
+        const int st = L2P(NULL, &errtext, "trace", DGAUSS, "--scene", scene, SIZE, "--spp",
+                           "1", "-q", "-o", prefix);
+        cr_expect_eq(st, 0, "camera %d: exit %d: %s", k, st, errtext);
+        char warning[700];
+        snprintf(warning, sizeof warning, "lens2pov: warning: %s: the camera's normal { } is left "
+                 "out", scene);
+        cr_expect_eq(errtext && strstr(errtext, warning) != NULL, k < 2, "camera %d: %s", k,
+                     errtext ? errtext : "");
+        free(errtext);
+    }
+}
+
 /* Any other directive inside the block, a conditional that does not stand between items (in
    an expression, or before a word that is no item), a type chosen by a conditional that runs,
    or a word that is no camera item is refused naming the statement's line (exit 2); a type in

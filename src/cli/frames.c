@@ -112,8 +112,13 @@ int render_frames_plan(const cli *c, render_frames *out, l2p_error *err)
     out->animated = sf.animated;
     out->digits = povargs_frame_digits(sf.final_frame);
     out->tables = sf.animated ? 0 : 1;
-    for (int i = 0; !st && i < sf.count; i++, out->count++)
+    bool perturbed = false;
+    for (int i = 0; !st && i < sf.count; i++, out->count++) {
         st = plan_frame(out, i, c, &sf, err);
+        perturbed = perturbed || sf.frame[i].cam.perturbed;
+    }
+    if (!st)
+        framing_warn_perturbed(c->positional[0], perturbed && !c->placed);
     scene_frames_free(&sf);
     return st;
 }

@@ -13,9 +13,18 @@ int framing_from_scene(cli *c, const char *scene, l2p_error *err)
         return L2P_OK;
     scene_camera sc;
     const int st = scene_camera_read(scene, c->cam.width, c->cam.height, &sc, err);
-    if (!st)
+    if (!st) {
         framing_apply(c, &sc);
+        framing_warn_perturbed(scene, sc.perturbed && !c->placed);
+    }
     return st;
+}
+
+void framing_warn_perturbed(const char *scene, bool perturbed)
+{
+    if (perturbed)
+        fprintf(stderr, "lens2pov: warning: %s: the camera's normal { } is left out: a lens does "
+                "not perturb its rays\n", scene);
 }
 
 void framing_apply(cli *c, const scene_camera *s)

@@ -14,6 +14,9 @@
    on the look_at point. */
 int framing_from_scene(cli *c, const char *scene, l2p_error *err);
 
+/* The warning for a scene camera with a normal { } (perturbed), which the lens leaves out. */
+void framing_warn_perturbed(const char *scene, bool perturbed);
+
 /* The same from a scene camera already read (one frame of an animation). */
 void framing_apply(cli *c, const scene_camera *sc);
 

@@ -42,6 +42,7 @@ typedef struct pov_camera {
     vec3 location, direction, up, right, sky, look_at, focus, focal_point;
     double angle, focal_distance;
     bool has_look_at, has_angle, has_focal_point, declared, unsupported, directive, branch_type;
+    bool has_normal;           /* a normal { } perturbs POV-Ray's rays; the lens leaves it out */
     affine trans, pending;     /* the transforms so far; the one being read */
     double version;
 } pov_camera;
@@ -180,6 +181,8 @@ static bool take_item(pov_camera *c, const char *msg, const char *scene, int lin
         return c->unsupported = c->branch_type = true;
     if (!strcmp(word, "unknown"))
         return c->unsupported = true;
+    if (!strcmp(word, "normal"))
+        return c->has_normal = true;
     if (!strcmp(word, "angle")) {
         if (!read_numbers(rest, &c->angle, 1))
             return false;
@@ -302,6 +305,7 @@ static int to_scene_camera(const pov_camera *c, const char *scene, int line, sce
     out->hfov_deg = 2.0 * atan(0.5 * rl / dl) * 180.0 / M_PI;
     out->found = true;
     out->line = line;
+    out->perturbed = c->has_normal;
     return L2P_OK;
 }
 

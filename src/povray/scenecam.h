@@ -21,6 +21,7 @@ typedef struct scene_camera {
     double hfov_deg;           /* horizontal angle: 2 atan(|right| / (2 |direction|)) */
     bool found;                /* false: no camera statement ran, POV-Ray's default camera */
     int line;                  /* the statement's line in its file (0 when not found) */
+    bool perturbed;            /* it has a normal { }, which the lens leaves out */
 } scene_camera;
 
 /* Runs POV-Ray on a copy of the scene at width x height (image_width and image_height read so)

@@ -119,6 +119,8 @@ static bool literal_camera(lex_buf *t, const char *s, size_t open, size_t close,
             lex_puts(t, msg);
         } else if (kind == ITEM_TYPE) {
             lex_puts(t, "\nlens2pov-type perspective|\n");
+        } else if (lex_is_word(s, a, b, "normal")) {
+            lex_puts(t, "\nlens2pov-normal|\n");
         }
         i = e;
     }

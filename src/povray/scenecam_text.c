@@ -74,6 +74,8 @@ static void put_item(lex_buf *t, const char *s, size_t a, size_t b, size_t e, en
         lex_puts(t, "#debug \"\\nlens2pov-type ");
         lex_puts(t, name);
         lex_puts(t, "|\\n\" ");
+    } else if (lex_is_word(s, a, b, "normal")) {   /* left out, with a warning */
+        lex_puts(t, "#debug \"\\nlens2pov-normal|\\n\" ");
     }
 }
 
