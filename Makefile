@@ -56,6 +56,18 @@ $(BUILD)/obj/%.o: src/%.c Makefile
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_BASE) $(SAN) $(CFLAGS) -MMD -MP -c $< -o $@
 
+comma := ,
+# The lane tracers (src/optics/trace_lanes_*.c) are loops over lanes, worth having only when
+# vectorized: they are built at -O2 in every build, and in a sanitizer build with
+# UndefinedBehaviorSanitizer but not AddressSanitizer, whose check of each lane's loads and
+# stores keeps the loops scalar (at the sanitizer build's -O1, with ASan, they were 50 times
+# slower than in the release build, most of the sanitizer suite's time).
+# Their arithmetic is the one-ray tracer's text (trace_kernel.h), which ASan checks, and their
+# memory a trace_batch's fixed arrays, which checked code fills.
+$(BUILD)/obj/optics/trace_lanes_%.o: src/optics/trace_lanes_%.c Makefile
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_BASE) -O2 $(subst -fsanitize=address$(comma),-fsanitize=,$(SAN)) $(CFLAGS) -MMD -MP -c $< -o $@
+
 # The only C++ (src/image/image_io.cpp) goes into the shared library only, hence -fPIC.
 $(BUILD)/obj/%.o: src/%.cpp Makefile
 	@mkdir -p $(@D)
