@@ -41,6 +41,20 @@ static image load(const char *path)
     return im;
 }
 
+/* The values (RGBA) in which two pictures of w x h differ. */
+static int values_differing(const char *path_a, const char *path_b, int w, int h)
+{
+    image a = load(path_a), b = load(path_b);
+    cr_assert(a.w == b.w && a.h == b.h && a.w == w && a.h == h, "%dx%d and %dx%d", a.w, a.h,
+              b.w, b.h);
+    int differ = 0;
+    for (size_t i = 0; i < 4 * (size_t)a.w * (size_t)a.h; i++)
+        differ += a.p[i] != b.p[i];
+    free(a.p);
+    free(b.p);
+    return differ;
+}
+
 static float at(const image *im, int x, int y, int c)
 {
     return im->p[4 * ((size_t)y * (size_t)im->w + (size_t)x) + (size_t)c];
@@ -623,14 +637,8 @@ Test(render, chunks_and_jobs_do_not_change_the_picture)
              "--keep-temp", keep, "--quiet", "-o", many, NULL);
     const int chunks = count_entries(keep, "rays.c", NULL, 0) / 3;   /* .inc .ini .exr */
     cr_expect_geq(chunks, 5, "only %d chunks", chunks);
-    image a = load(one), b = load(many);
-    cr_assert(a.w == b.w && a.h == b.h && a.w == 32 && a.h == 24);
-    int differ = 0;
-    for (size_t i = 0; i < 4 * (size_t)a.w * (size_t)a.h; i++)
-        differ += a.p[i] != b.p[i];
+    const int differ = values_differing(one, many, 32, 24);
     cr_expect_eq(differ, 0, "%d values differ between 1 chunk and %d chunks", differ, chunks);
-    free(a.p);
-    free(b.p);
     remove_tree(dir);
 }
 
@@ -652,14 +660,8 @@ Test(render, a_crop_in_the_users_ini_changes_nothing)
         run_lens2pov_ok("a crop in an ini", "render", scene, DGAUSS, "--sampling", samplings[k],
                         "--width", "32", "--height", "24", "--spp", "4", PLACE, "--quiet", "-o",
                         cropped, "--", ini, NULL);
-        image a = load(plain), b = load(cropped);
-        cr_assert(a.w == b.w && a.h == b.h && a.w == 32 && a.h == 24);
-        int differ = 0;
-        for (size_t i = 0; i < 4 * (size_t)a.w * (size_t)a.h; i++)
-            differ += a.p[i] != b.p[i];
+        const int differ = values_differing(plain, cropped, 32, 24);
         cr_expect_eq(differ, 0, "%s sampling: %d values differ", samplings[k], differ);
-        free(a.p);
-        free(b.p);
     }
     remove_tree(dir);
 }
