@@ -55,6 +55,30 @@ static void smooth_frame(povuv_face *f)
         f->perp[i] = (float)(pf[i] / den);
 }
 
+/* The affine form of povuv_weighted_ray (povuv.h), about the first vertex's UV, where the
+   weights of P2 and P3 are 0: there rel = o - P1 = b2 (P2 - P1) + b3 (P3 - P1), and the
+   weights' gradients over UV are the cofactors of povuv_face_weights divided by its scale. */
+static void affine_form(povuv_face *f)
+{
+    const double(*t)[2] = f->uv;
+    const double scale = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
+    const vec3 e1 = v3_sub(f->dp[1], f->dp[0]), e2 = v3_sub(f->dp[2], f->dp[0]);
+    povuv_affine *a = &f->affine;
+    a->u0 = t[0][0], a->v0 = t[0][1];
+    a->o0 = f->dp[0];
+    a->ou = v3_scale(v3_add(v3_scale(e1, t[2][1] - t[0][1]), v3_scale(e2, t[0][1] - t[1][1])), 1.0 / scale);
+    a->ov = v3_scale(v3_add(v3_scale(e1, t[0][0] - t[2][0]), v3_scale(e2, t[1][0] - t[0][0])), 1.0 / scale);
+    /* Smooth_Mesh_Normal's u = rel . Perp, and u v = (rel[vaxis] + (P1 - P2)[vaxis] u) / (P3 - P2)[vaxis] */
+    const double uu_u = v3_dot(a->ou, f->dperp), uu_v = v3_dot(a->ov, f->dperp);
+    const double uv_u = (axis_of(a->ou, f->vaxis) + (f->p1v - f->p2v) * uu_u) / f->p32v;
+    const double uv_v = (axis_of(a->ov, f->vaxis) + (f->p1v - f->p2v) * uu_v) / f->p32v;
+    a->r0 = f->dn1;
+    a->ru = v3_add(v3_scale(f->dn21, uu_u), v3_scale(f->dn32, uv_u));
+    a->rv = v3_add(v3_scale(f->dn21, uu_v), v3_scale(f->dn32, uv_v));
+    f->has_affine = v3_isfinite(a->ou) && v3_isfinite(a->ov) && v3_isfinite(a->ru) && v3_isfinite(a->rv) &&
+                    v3_isfinite(a->r0) && v3_isfinite(a->o0);
+}
+
 static void put3(float out[3], const double in[3])
 {
     for (int i = 0; i < 3; i++)
@@ -97,17 +121,48 @@ void povuv_face_init(povuv_face *f, const double pos[3][3], const double nrm[3][
     f->p1v = f->p[0][f->vaxis];
     f->p2v = f->p[1][f->vaxis];
     f->p32v = (double)f->p[2][f->vaxis] - f->p[1][f->vaxis];
+    affine_form(f);
+}
+
+void povuv_affine_ray(const povuv_face *f, double u, double v, vec3 *o, vec3 *r)
+{
+    const povuv_affine *a = &f->affine;
+    const double du = u - a->u0, dv = v - a->v0;
+    *o = v3_madd(v3_madd(a->o0, a->ou, du), a->ov, dv);
+    *r = v3_madd(v3_madd(a->r0, a->ru, du), a->rv, dv);
 }
 
 /* tracepixel.cpp: scale = (P2-P1) x (P3-P1) in UV; B1 = ((P2-X) x (P3-X)) / scale, and so on
-   around the face. */
-void povuv_face_weights(const povuv_face *f, double u, double v, double b[3])
+   around the face. Here the numerators, and the scale. */
+static double weight_numerators(const povuv_face *f, double u, double v, double n[3])
 {
     const double(*t)[2] = f->uv;
-    double scale = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
-    b[0] = ((t[1][0] - u) * (t[2][1] - v) - (t[2][0] - u) * (t[1][1] - v)) / scale;
-    b[1] = ((t[2][0] - u) * (t[0][1] - v) - (t[0][0] - u) * (t[2][1] - v)) / scale;
-    b[2] = ((t[0][0] - u) * (t[1][1] - v) - (t[1][0] - u) * (t[0][1] - v)) / scale;
+    n[0] = (t[1][0] - u) * (t[2][1] - v) - (t[2][0] - u) * (t[1][1] - v);
+    n[1] = (t[2][0] - u) * (t[0][1] - v) - (t[0][0] - u) * (t[2][1] - v);
+    n[2] = (t[0][0] - u) * (t[1][1] - v) - (t[1][0] - u) * (t[0][1] - v);
+    return (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
+}
+
+void povuv_face_weights(const povuv_face *f, double u, double v, double b[3])
+{
+    const double scale = weight_numerators(f, u, v, b);
+    for (int k = 0; k < 3; k++)
+        b[k] /= scale;
+}
+
+/* With the UVs and (u, v) short binary fractions, as lens2pov's are, the numerators are exact,
+   and a weight is >= 0 exactly when its numerator is 0 or has the scale's sign. */
+bool povuv_face_holds(const povuv_face *f, double u, double v)
+{
+    double n[3];
+    const double scale = weight_numerators(f, u, v, n);
+    if (scale > 0)
+        return n[0] >= 0 && n[1] >= 0 && n[2] >= 0;
+    if (scale < 0)
+        return n[0] <= 0 && n[1] <= 0 && n[2] <= 0;
+    double b[3];   /* 0/0 or x/0: as POV-Ray divides */
+    povuv_face_weights(f, u, v, b);
+    return b[0] >= 0 && b[1] >= 0 && b[2] >= 0;
 }
 
 bool povuv_face_ray(const povuv_face *f, double u, double v, vec3 *o, vec3 *d)

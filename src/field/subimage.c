@@ -35,6 +35,7 @@ typedef struct builder {
     const field_tolerance *tol;
     double per_sin2;           /* 1 / sin(tol->angle_rad)^2 */
     double per_origin2;        /* 1 / tol->origin_mm^2 */
+    float *stricter;           /* a pixel's factor on the squared error, >= 1 (pixel_scale) */
     int w, h;
     ray *rays;                 /* mesh space: camera space less the front vertex */
     unsigned char *passed, *covered;
@@ -119,6 +120,50 @@ static void trace_all(builder *b, film_sample s)
                                                    b->sum[(y + 1) * (b->w + 1) + x] - b->sum[y * (b->w + 1) + x];
 }
 
+/* The change of the exact direction a pixel step along (sx, sy) makes at pixel (x, y): half the
+   difference of the neighbours' either side, or the difference with the one that passes;
+   false when neither does. */
+static bool direction_step(const builder *b, int x, int y, int sx, int sy, vec3 *step)
+{
+    const ray *r[2] = {NULL, NULL};
+    for (int k = 0; k < 2; k++) {
+        const int nx = x + (k ? sx : -sx), ny = y + (k ? sy : -sy);
+        if (nx >= 0 && ny >= 0 && nx < b->w && ny < b->h && b->passed[ny * b->w + nx])
+            r[k] = &b->rays[ny * b->w + nx];
+    }
+    const ray *at = &b->rays[y * b->w + x];
+    if (r[0] && r[1])
+        *step = v3_scale(v3_sub(r[1]->d, r[0]->d), 0.5);
+    else if (r[0] || r[1])
+        *step = r[1] ? v3_sub(r[1]->d, at->d) : v3_sub(at->d, r[0]->d);
+    return r[0] || r[1];
+}
+
+/* The tolerance is a distance on the film: an error of angle e in the direction moves the
+   ray's subject by at most e / s pixels, s the smallest angle a pixel step turns the exact
+   direction by (the least singular value of the field's Jacobian, from the neighbours' rays).
+   field_tolerance's angle is the centre's, p / f; where a pixel spans less (off the axis of
+   most lenses: p cos^2(theta) / f radially through a distortion-free one), the pixel's errors
+   count (p / f / s)^2 times, at most FIELD_MOST_STRICTER times; where it spans more, as at the
+   centre, so that the angle stays within field_tolerance's too. */
+static void pixel_scale(builder *b)
+{
+    const double centre = b->tol->angle_rad / b->tol->pixels;
+    for (int y = 0; y < b->h; y++)
+        for (int x = 0; x < b->w; x++) {
+            const int i = y * b->w + x;
+            vec3 jx, jy;
+            b->stricter[i] = 1.0f;
+            if (!b->passed[i] || !direction_step(b, x, y, 1, 0, &jx) || !direction_step(b, x, y, 0, 1, &jy))
+                continue;
+            const double gxx = v3_dot(jx, jx), gyy = v3_dot(jy, jy), gxy = v3_dot(jx, jy);
+            const double tr = gxx + gyy, det = gxx * gyy - gxy * gxy;
+            const double least2 = 0.5 * (tr - sqrt(fmax(tr * tr - 4 * det, 0.0)));
+            const double k = centre * centre / least2;
+            b->stricter[i] = (float)(k > 1 ? (k < FIELD_MOST_STRICTER ? k : FIELD_MOST_STRICTER) : 1);
+        }
+}
+
 /* Passing pixels in [x0, x1] x [y0, y1] (inclusive). */
 static long passing(const builder *b, int x0, int y0, int x1, int y1)
 {
@@ -143,38 +188,43 @@ static void pixel_face(const builder *b, const int px[3][2], povuv_face *f)
     povuv_face_init(f, pos, nrm, uv);
 }
 
-/* The square of the error of the model's ray against the exact one, in units of the
-   tolerance. For unit directions |a x b| is the sine of the angle between them: below a right
-   angle, comparing sines is comparing angles, without an atan2 at every pixel; squares spare
-   the square roots. */
+/* The square of the error of the model's ray (origin o, direction d of any length) against the
+   exact one, in units of the tolerance. For a unit a, |a x d| / |d| is the sine of the angle
+   between a and d: below a right angle, comparing sines is comparing angles, without an atan2
+   at every pixel; squares spare the square roots. */
 static double ray_error_squared(const builder *b, const ray *exact, vec3 o, vec3 d)
 {
+    const double d2 = v3_dot(d, d);
+    if (!(d2 > 0) || !isfinite(d2) || !v3_isfinite(o) || !(v3_dot(exact->d, d) > 0))
+        return INFINITY;
     const vec3 turn = v3_cross(exact->d, d);
     vec3 e = v3_sub(o, exact->o);
     vec3 across = v3_sub(e, v3_scale(exact->d, v3_dot(e, exact->d)));
-    return v3_dot(exact->d, d) > 0
-               ? fmax(v3_dot(turn, turn) * b->per_sin2, v3_dot(across, across) * b->per_origin2)
-               : INFINITY;
+    const double sin2 = v3_dot(turn, turn) / d2 * b->per_sin2, off2 = v3_dot(across, across) * b->per_origin2;
+    return sin2 > off2 ? sin2 : off2;
 }
 
 /* Whether pixel (x, y) is fine with face f: outside it, or inside with a ray within the
-   tolerance. *worst is the largest error seen, in units of the tolerance. */
+   tolerance, less FIELD_AFFINE_MARGIN when the face's affine form gives the ray. *worst is the
+   largest error seen, in units of the tolerance. */
 static bool pixel_ok(const builder *b, const povuv_face *f, int x, int y, double *worst)
 {
+    static const double most = (1 - FIELD_AFFINE_MARGIN) * (1 - FIELD_AFFINE_MARGIN);
     double u, v, w[3];
     povuv_pixel_uv(b->m->render_w, b->m->render_h, x, y, &u, &v);
-    povuv_face_weights(f, u, v, w);
-    if (!(w[0] >= 0 && w[1] >= 0 && w[2] >= 0))
+    if (!povuv_face_holds(f, u, v))
         return true;
     if (!b->passed[y * b->w + x])
         return false;
     vec3 o, d;
-    if (!povuv_weighted_ray(f, w, &o, &d))
+    if (f->has_affine)
+        povuv_affine_ray(f, u, v, &o, &d);
+    else if (povuv_face_weights(f, u, v, w), !povuv_weighted_ray(f, w, &o, &d))
         return false;
-    const double e2 = ray_error_squared(b, &b->rays[y * b->w + x], o, d);
+    const double e2 = ray_error_squared(b, &b->rays[y * b->w + x], o, d) * b->stricter[y * b->w + x];
     if (e2 > *worst * *worst)
         *worst = sqrt(e2);
-    return e2 <= 1.0;
+    return e2 <= (f->has_affine ? most : 1.0);
 }
 
 /* Whether the pixel nearest the centroid of the face whose corners are the pixels px is fine
@@ -351,12 +401,10 @@ static bool try_hull(builder *b, int x0, int y0, int x1, int y1)
     /* the pixels the faces hold, as POV-Ray finds them */
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
-            double u, v, w[3];
+            double u, v;
             povuv_pixel_uv(b->m->render_w, b->m->render_h, x, y, &u, &v);
-            for (int k = 0; k < faces && !b->covered[y * b->w + x]; k++) {
-                povuv_face_weights(&f[k], u, v, w);
-                b->covered[y * b->w + x] = w[0] >= 0 && w[1] >= 0 && w[2] >= 0;
-            }
+            for (int k = 0; k < faces && !b->covered[y * b->w + x]; k++)
+                b->covered[y * b->w + x] = povuv_face_holds(&f[k], u, v);
         }
     return true;
 }
@@ -519,10 +567,12 @@ int field_build_subimage(const camera *c, film_sample s, const field_tolerance *
     b.covered = calloc(n, 1);
     b.sum = calloc((size_t)(b.w + 1) * (b.h + 1), sizeof *b.sum);
     b.vid = malloc(n * sizeof *b.vid);
-    b.oom = !b.rays || !b.passed || !b.covered || !b.sum || !b.vid;
+    b.stricter = malloc(n * sizeof *b.stricter);
+    b.oom = !b.rays || !b.passed || !b.covered || !b.sum || !b.vid || !b.stricter;
     if (!b.oom) {
         memset(b.vid, 0xff, n * sizeof *b.vid);
         trace_all(&b, s);
+        pixel_scale(&b);
     }
     if (!b.oom)
         build_grid(&b, base_cell < 1 ? 1 : base_cell);
@@ -531,7 +581,7 @@ int field_build_subimage(const camera *c, film_sample s, const field_tolerance *
     st->blocked = (long)n - st->passed;
     st->faces = out->faces;
     st->vertices = out->vertices;
-    free(b.rays), free(b.passed), free(b.covered), free(b.sum), free(b.vid);
+    free(b.rays), free(b.passed), free(b.covered), free(b.sum), free(b.vid), free(b.stricter);
     if (b.oom)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory building a ray field");
     return L2P_OK;

@@ -20,6 +20,18 @@ typedef struct field_tolerance {
    to the plane in focus), at most 100 f. */
 void field_tolerance_of(const camera *c, double pixels, field_tolerance *t);
 
+/* The builder checks each pixel with the face's affine form of the model (povuv_affine_ray),
+   which agrees with the model to far less than this share of the tolerance (test_field.c
+   measures it), and keeps this much of the tolerance back for it: a pixel the builder passes
+   is within the tolerance by the model itself. */
+#define FIELD_AFFINE_MARGIN 1e-6
+
+/* The most a pixel's squared error is scaled by where a pixel spans a smaller angle than at the
+   film's centre (subimage.c, pixel_scale): a quarter of the centre's angle. Real lenses stay
+   far from it (the 22 mm wide angle's corners on a 35 mm film: 2.7); it bounds what a lens
+   whose field folds asks of POV-Ray's float32 rays. */
+#define FIELD_MOST_STRICTER 16.0
+
 /* What building a sub-image found. */
 typedef struct field_stats {
     int faces, lone_faces, vertices;
