@@ -218,3 +218,24 @@ ParameterizedTest(library_lens *l, library, renders_the_bundled_scene)
     free(errtext);
     remove_tree(dir);
 }
+
+/* The focus distance info reports is the one asked for: infinity as null (it was a huge number
+   of either sign, the film's rounding divided by nearly zero), and 3 units as 3. */
+ParameterizedTestParameters(library, info_reports_the_focus_distance_asked_for)
+{
+    return library();
+}
+
+ParameterizedTest(library_lens *l, library, info_reports_the_focus_distance_asked_for)
+{
+    char *out = NULL, *errtext = NULL;
+    int st = run_lens2pov(&out, &errtext, "info", l->path, "--json", "--focus-distance", "inf", NULL);
+    cr_assert_eq(st, 0, "%s: exit %d: %s", l->path, st, errtext);
+    cr_expect(strstr(out, "\"focus_distance\": null") != NULL, "%s: %s", l->path,
+              strstr(out, "\"focus_distance\""));
+    free(out), free(errtext);
+    st = run_lens2pov(&out, &errtext, "info", l->path, "--json", "--focus-distance", "3", NULL);
+    cr_assert_eq(st, 0, "%s: exit %d: %s", l->path, st, errtext);
+    cr_expect_eq(json_number(out, "focus_distance"), 3.0, "%s", l->path);
+    free(out), free(errtext);
+}

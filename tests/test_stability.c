@@ -185,6 +185,16 @@ static char *lens_stop_last(void)
                   "0     0    0     10\n");
 }
 
+/* A dummy surface behind the stop, air on both sides, as design programs export: it bends no
+   ray, so the stop is its own exit pupil. */
+static char *lens_dummy_after_stop(void)
+{
+    return strdup("50    6    1.5   25\n"
+                  "-50   1    1     25\n"
+                  "0     4.5  0     17.1\n"
+                  "40    0    1     20\n");
+}
+
 /* One refracting surface: the film lies in the glass behind it. */
 static char *lens_single_surface(void)
 {
@@ -627,6 +637,10 @@ static void check_traced(const stab_case *sc, const case_args *a, const char *le
 {
     stab_result res;
     memset(&res, 0, sizeof res);
+    char *info_err = NULL;   /* a lens trace takes, info describes */
+    const int info_st = run_lens2pov(NULL, &info_err, "info", lens_path, NULL);
+    cr_expect_eq(info_st, 0, "%s: trace takes the lens, info refuses it: %s", sc->name, info_err);
+    free(info_err);
     size_t nrows;
     csv_ray *rows = read_rays_csv(csv, &nrows);
     for (size_t k = 0; k < nrows; k++) {
@@ -780,6 +794,8 @@ static const stab_case CASES[] = {
      .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
     {.name = "stop-last", .what = "the stop as the last surface", .lens = lens_stop_last,
      .args = "--focus-distance 3", .pass_min = 0.5, .pass_max = 1.0},
+    {.name = "dummy-after-stop", .what = "an air-to-air surface behind the stop",
+     .lens = lens_dummy_after_stop, .args = "--focus-distance 3", .pass_min = 0.9, .pass_max = 1.0},
     {.name = "single-surface", .what = "a single refracting surface (film in the glass)",
      .lens = lens_single_surface, .args = "--focus-distance 3 --film-diagonal 10", .pass_min = 0.5,
      .pass_max = 1.0},
@@ -845,6 +861,7 @@ STAB_TEST(film_far_behind_the_lens, "film-far")
 STAB_TEST(film_too_far_behind_the_lens_is_refused, "film-too-far")
 STAB_TEST(stop_first, "stop-first")
 STAB_TEST(stop_last, "stop-last")
+STAB_TEST(dummy_surface_behind_the_stop, "dummy-after-stop")
 STAB_TEST(single_refracting_surface, "single-surface")
 STAB_TEST(film_distance_0, "film-distance-0")
 STAB_TEST(film_distance_0_rear_pupil, "film-distance-0-rear")

@@ -148,8 +148,13 @@ static int setup_focus(camera *c, const camera_options *o, l2p_error *err)
         int st = check_film_position(l, true, NAN, err);
         if (st)
             return st;
+        c->focus_distance_units = focus_distance_mm(l) / o->unit_mm;
+    } else {
+        /* the distance focused at, not one computed back from the film: at infinity that is a
+           division by the rounding error of the film's place, a huge number of either sign */
+        c->focus_distance_units = isnan(o->focus_distance_units) ? v3_length(v3_sub(o->look_at, o->location))
+                                                                 : o->focus_distance_units;
     }
-    c->focus_distance_units = focus_distance_mm(l) / o->unit_mm;
     return L2P_OK;
 }
 

@@ -15,15 +15,16 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
     l.stop_diameter_mm = l.surface[l.stop].aperture_diameter_mm;
     lens_set_film_distance(&l, 0.0);
     thick_lens t;
-    pupil exit;
-    double ep_z, ep_r;
+    double ep_z, ep_r, xp_z, xp_r;
     int st = thick_lens_of(&l, 0, l.count - 1, &t, err);
     if (!st)
         st = focus_check_real_image(&l, &t, err);   /* as trace's focusing refuses it */
     if (!st)
         st = pupil_stop_image(&l, false, &ep_z, &ep_r, err);
+    /* the pupils alone, not a pupil to sample: with the film at the rear vertex, a stop there
+       would be a pupil in the film plane, which sampling refuses */
     if (!st)
-        st = pupil_make(&l, PUPIL_STOP_IMAGE, &exit, err);
+        st = pupil_stop_image(&l, true, &xp_z, &xp_r, err);
     if (!st) {
         memset(out, 0, sizeof *out);
         out->efl_mm = thick_efl_mm(&t);
@@ -36,8 +37,8 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
         out->p2_from_rear_mm = t.p2_z_mm;
         out->entrance_pupil_from_rear_mm = ep_z;
         out->entrance_pupil_diameter_mm = 2.0 * ep_r;
-        out->exit_pupil_from_rear_mm = exit.z_mm;
-        out->exit_pupil_diameter_mm = 2.0 * exit.radius_mm;
+        out->exit_pupil_from_rear_mm = xp_z;
+        out->exit_pupil_diameter_mm = 2.0 * xp_r;
     }
     lens_free(&l);
     return st;

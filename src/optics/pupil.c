@@ -17,12 +17,24 @@ int pupil_kind_parse(const char *name, pupil_kind *k)
     return -1;
 }
 
+/* Whether surfaces first..last bend no ray: each has the medium of the one before it (air in
+   front of the first surface), as dummy and baffle rows exported by design programs do. */
+static bool refracts_nothing(const lens *l, int first, int last)
+{
+    for (int k = first; k <= last; k++) {
+        const double before = k > 0 ? l->surface[k - 1].ior : 1.0, abbe = k > 0 ? l->surface[k - 1].abbe : 0.0;
+        if (l->surface[k].ior != before || l->surface[k].abbe != abbe)
+            return false;
+    }
+    return true;
+}
+
 int pupil_stop_image(const lens *l, bool toward_film, double *z_mm, double *radius_mm,
                      l2p_error *err)
 {
     const lens_surface *stop = &l->surface[l->stop];
     const int first = toward_film ? l->stop + 1 : 0, last = toward_film ? l->count - 1 : l->stop - 1;
-    if (first > last) {           /* nothing on that side: the stop is its own image */
+    if (first > last || refracts_nothing(l, first, last)) {   /* the stop is its own image */
         *z_mm = stop->vertex_z_mm;
         *radius_mm = 0.5 * l->stop_diameter_mm;
         return L2P_OK;
