@@ -22,7 +22,7 @@ OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenIm
 # OpenImageIO is not linked into the executables: src/image/image_io.cpp alone becomes
 # lens2pov-image-io.so beside them, which src/image/image_io_loader.c dlopen()s on the first image read
 # or write (`info` and `trace` never load it). The library calls back into the executable for
-# these four functions, so every executable that may load it exports them.
+# these five functions, so every executable that may load it exports them.
 IMAGE_IO_SO    = $(BUILD)/lens2pov-image-io.so
 # src/povray/povray_polls.c alone becomes lens2pov-povray-polls.so beside them, which the POV-Ray
 # processes lens2pov starts preload (src/povray/povray_env.c): never with the sanitizers, since
@@ -30,7 +30,8 @@ IMAGE_IO_SO    = $(BUILD)/lens2pov-image-io.so
 POLLS_SO       = $(BUILD)/lens2pov-povray-polls.so
 IMAGE_IO_HOST  = -Wl,--export-dynamic-symbol=l2p_fail -Wl,--export-dynamic-symbol=cleanup_track \
                  -Wl,--export-dynamic-symbol=cleanup_untrack \
-                 -Wl,--export-dynamic-symbol=outfile_create_temp
+                 -Wl,--export-dynamic-symbol=outfile_create_temp \
+                 -Wl,--export-dynamic-symbol=outfile_target
 
 DEB_PACKAGES = povray povray-includes libopenimageio-dev openimageio-tools libcriterion-dev \
                pkg-config g++ gnuplot-nox valgrind clang libclang-rt-14-dev fonts-dejavu-core libxml2-utils \

@@ -734,6 +734,33 @@ Test(image_io, atomic_write_leaves_no_temp)
     free(px);
 }
 
+/* An output named by a symbolic link (here a relative one, to a folder beside it) is written
+   through it: the link stays a link and its target gets the picture. A link loop is refused
+   by name. */
+Test(image_io, an_output_named_by_a_link_is_written_through_it)
+{
+    const char *dir = test_tmpdir();
+    char *sub = strdup(tmp_path(dir, "pictures"));
+    cr_assert_eq(mkdir(sub, 0755), 0);
+    char *link = strdup(tmp_path(dir, "latest.png"));
+    cr_assert_eq(symlink("pictures/shot.png", link), 0);
+    float rgb[3 * 4];
+    fill_rgb(rgb, 4, 0.25f);
+    l2p_error err = {0, ""};
+    cr_assert_eq(image_write_rgb(link, 2, 2, rgb, NULL, 0, &err), L2P_OK, "%s", err.text);
+    struct stat sb;
+    cr_assert_eq(lstat(link, &sb), 0);
+    cr_assert(S_ISLNK(sb.st_mode), "the link was replaced");
+    cr_assert(file_exists(tmp_path(dir, "pictures/shot.png")));
+    cr_assert_eq(count_entries(sub, ".", NULL, 0), 0, "a temporary file was left");
+
+    char *loop = strdup(tmp_path(dir, "loop.png"));
+    cr_assert_eq(symlink("loop.png", loop), 0);
+    cr_assert_eq(image_write_rgb(loop, 2, 2, rgb, NULL, 0, &err), L2P_BAD_INPUT);
+    cr_assert(strstr(err.text, loop) && strstr(err.text, "symbolic links"), "%s", err.text);
+    free(sub), free(link), free(loop);
+}
+
 Test(image_io, read_errors)
 {
     const char *dir = test_tmpdir();

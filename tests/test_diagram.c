@@ -173,6 +173,16 @@ Test(diagram, bad_requests_exit_2)
     cr_assert_not(file_exists(svg));
     cr_assert_eq(run_lens2pov(NULL, &err, "diagram", "dgauss.50mm", "--spp", "4", "-o", svg, NULL), 2);
     free(err);
+    /* the name says what the file is: SVG, and plot's PNG */
+    const char *png = tmp_path(dir, "x.png");
+    cr_assert_eq(run_lens2pov(NULL, &err, "diagram", "dgauss.50mm", "-o", png, NULL), 2);
+    cr_assert(err && strstr(err, "SVG") && strstr(err, png), "%s", err);
+    free(err);
+    cr_assert_eq(run_lens2pov(NULL, &err, "plot", "dgauss.50mm", "--what", "distortion", "-o", svg, NULL), 2);
+    cr_assert(err && strstr(err, "PNG") && strstr(err, svg), "%s", err);
+    free(err);
+    cr_assert_not(file_exists(png));
+    cr_assert_not(file_exists(svg));
 }
 
 /* ---- plot */
@@ -227,6 +237,24 @@ Test(plot, vignetting_falls_from_1_toward_the_corner)
         cr_assert_lt(rows[i][1], rows[i - 1][1] + 1e-3, "full aperture, row %d", i);
     cr_assert_lt(rows[n - 1][1], 0.8 * rows[n - 1][4], "wide open vignettes more than f/16");
     free(out);
+}
+
+/* --trace thick plots the thick lens's own light (its exit pupil's disk, which test_pupil.c
+   checks against its samples): the full lens's vignetting is gone, only the disk's falloff is
+   left, about cos^4 at the corner, far above the full lens wide open. */
+Test(plot, vignetting_follows_trace_thick)
+{
+    const char *png = tmp_path(test_tmpdir(), "vt.png");
+    char *full = NULL, *thick = NULL;
+    cr_assert_eq(run_lens2pov(&full, NULL, "plot", "dgauss.50mm", "--what", "vignetting", "-o", png, NULL), 0);
+    cr_assert_eq(run_lens2pov(&thick, NULL, "plot", "dgauss.50mm", "--what", "vignetting", "--trace",
+                              "thick", "-o", png, NULL), 0);
+    double f[64][5], t[64][5];
+    const int n = read_table(full, f, 5);
+    cr_assert_eq(read_table(thick, t, 5), n);
+    cr_assert_gt(t[n - 1][1], 1.5 * f[n - 1][1], "thick %g, full %g at the corner", t[n - 1][1], f[n - 1][1]);
+    cr_assert_gt(t[n - 1][1], 0.7);
+    free(full), free(thick);
 }
 
 Test(plot, distortion_is_0_on_the_axis)

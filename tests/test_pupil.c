@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "camera/camera.h"
+#include "optics/irradiance.h"
 #include "support.h"
 #include "optics/trace_batch.h"
 
@@ -310,6 +311,35 @@ Test(pupil, irradiance_matches_an_independent_integral_over_the_lens)
                           "%s f/%g, film (%.2f, %.2f): lens2pov %.6g, the lens passes %.6g "
                           "(%+.3f%%, tolerance %.3f%%)", LENSES[li], f_numbers[fi], p.x, p.y,
                           got, want, 100.0 * (got / want - 1.0), 100.0 * tolerance / want);
+            }
+            camera_free(&c);
+        }
+}
+
+/* With --trace thick the light comes through the exit pupil, the stop's image, and nothing else
+   stops it: the mean weight of the thick camera's samples is the disk's projected solid angle
+   (irradiance_through_disk, which plot --what vignetting --trace thick draws). */
+Test(pupil, thick_irradiance_is_the_exit_pupils_disk)
+{
+    const double f_numbers[] = {NAN, 8.0};
+    for (int li = 0; li < 2; li++)
+        for (int fi = 0; fi < 2; fi++) {
+            camera_options o;
+            camera_options_default(&o);
+            o.width = 64, o.height = 48, o.focus_distance_units = 10.0, o.f_number = f_numbers[fi];
+            o.weighting = WEIGHTING_PHYSICAL, o.trace = TRACE_KIND_THICK;
+            camera c;
+            test_camera(&c, LENSES[li], &o);
+            double z, radius;
+            l2p_error err;
+            cr_assert_eq(pupil_stop_image(&c.lens, true, &z, &radius, &err), L2P_OK);
+            for (int i = 0; i < POINTS; i++) {
+                const vec3 p = film_point(&c, i);
+                double se;
+                const double got = estimate(&c, p, SIDE, &se);
+                const double want = irradiance_through_disk(v3_length(p), z, radius);
+                cr_assert(fabs(got - want) <= 4.0 * se + 1e-4 * want, "%s f/%g, film (%.2f, %.2f): "
+                          "%.6g, the disk %.6g", LENSES[li], f_numbers[fi], p.x, p.y, got, want);
             }
             camera_free(&c);
         }

@@ -663,6 +663,93 @@ Test(robustness, planted_links_never_receive_a_temporary_file)
     free(b);
 }
 
+/* Text outputs named by symbolic links (an absolute one and a chain of two) are written
+   through them, and the links stay. */
+Test(robustness, outputs_named_by_links_are_written_through_them)
+{
+    const char *dir = test_tmpdir();
+    char *svg = strdup(tmp_path(dir, "lens.svg")), *csv = strdup(tmp_path(dir, "rays.csv"));
+    char *svg_link = strdup(tmp_path(dir, "diagram.svg")), *csv_link = strdup(tmp_path(dir, "a.csv"));
+    char *csv_middle = strdup(tmp_path(dir, "b.csv"));
+    cr_assert_eq(symlink(svg, svg_link), 0);
+    cr_assert_eq(symlink("b.csv", csv_link), 0);
+    cr_assert_eq(symlink("rays.csv", csv_middle), 0);
+    run_lens2pov_ok("diagram", "diagram", DGAUSS, "-o", svg_link, NULL);
+    run_lens2pov_ok("trace", "trace", DGAUSS, "--width", "8", "--height", "6", "--spp", "1", "-o",
+                    tmp_path(dir, "t"), "--rays", csv_link, "--quiet", NULL);
+    struct stat sb;
+    const char *links[] = {svg_link, csv_link, csv_middle};
+    for (int i = 0; i < 3; i++) {
+        cr_assert_eq(lstat(links[i], &sb), 0);
+        cr_assert(S_ISLNK(sb.st_mode), "%s was replaced", links[i]);
+    }
+    size_t n;
+    char *text = read_text(svg, &n);
+    cr_assert(text && strstr(text, "<svg"), "the diagram did not reach the link's target");
+    free(text);
+    text = read_text(csv, &n);
+    cr_assert(text && n > 100, "the rays did not reach the end of the chain");
+    free(text);
+    free(svg), free(csv), free(svg_link), free(csv_link), free(csv_middle);
+}
+
+/* An output may not be an input: each is refused (exit 2, naming the file and what it is)
+   before any work, and the input is left as it was. */
+Test(robustness, an_output_naming_an_input_is_refused)
+{
+    const char *dir = test_tmpdir();
+    char *lens = strdup(tmp_path(dir, "mine.dat")), *scene = strdup(tmp_path(dir, "scene.png"));
+    char *link = strdup(tmp_path(dir, "link.svg")), *prefix = strdup(tmp_path(dir, "t"));
+    char *lens_inc = strdup(tmp_path(dir, "t.inc"));
+    size_t n;
+    char *text = read_text(DGAUSS, &n);
+    write_text(lens, text);
+    write_text(lens_inc, text);
+    write_text(scene, "camera { location <0, 0, -5> look_at 0 } sphere { 0, 1 pigment { rgb 1 } }\n");
+    cr_assert_eq(symlink(lens, link), 0);
+    run_lens2pov_ok("trace", "trace", lens, "--width", "8", "--height", "6", "--spp", "1", "-o",
+                    tmp_path(dir, "p"), "--quiet", NULL);
+    char *picture = strdup(tmp_path(dir, "p.exr"));
+    write_text(picture, "stands for POV-Ray's render\n");
+    struct {
+        const char *args[16], *victim, *role;
+    } cases[] = {
+        {{"trace", lens, "--width", "8", "--height", "6", "-o", prefix, "--rays", lens, NULL}, lens, "the lens"},
+        {{"trace", lens_inc, "--width", "8", "--height", "6", "-o", prefix, NULL}, lens_inc, "the lens"},
+        {{"diagram", lens, "-o", link, NULL}, lens, "the lens"},
+        {{"render", scene, lens, "--width", "8", "--height", "6", "-o", scene, NULL}, scene, "the scene"},
+        {{"develop", tmp_path(dir, "p"), "-o", picture, NULL}, picture, "a render to develop"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char *before = read_text(cases[k].victim, &n), *out = NULL, *errout = NULL;
+        const int status = run_lens2pov_argv(&out, &errout, (char *const *)cases[k].args);
+        cr_expect_eq(status, 2, "%s: exit %d: %s", cases[k].args[0], status, errout);
+        cr_expect(errout && strstr(errout, cases[k].role), "%s: %s", cases[k].args[0], errout);
+        char *after = read_text(cases[k].victim, &n);
+        cr_expect_str_eq(after, before, "%s overwrote %s", cases[k].args[0], cases[k].victim);
+        free(before), free(after), free(out), free(errout);
+    }
+    free(text), free(lens), free(scene), free(link), free(prefix), free(lens_inc), free(picture);
+}
+
+/* A stop so small that diffraction would blur every point over more than 1% of the film's
+   diagonal is traced, with a warning naming the Airy disk: 2.44 x 550 nm x 10000 = 13.4 mm on
+   the double-Gauss at f/10000; at f/64 (0.086 mm, 0.25% of 35 mm) nothing is said. */
+Test(robustness, a_stop_too_small_for_ray_optics_is_warned_of)
+{
+    const char *dir = test_tmpdir();
+    char *errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "8", "--height", "6", "--spp", "1",
+                              "--f-number", "10000", "-o", tmp_path(dir, "a"), "--quiet", NULL), 0);
+    cr_expect(strstr(errtext, "warning: at f/1e+04 diffraction") && strstr(errtext, "13.4 mm"), "%s", errtext);
+    free(errtext);
+    errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "8", "--height", "6", "--spp", "1",
+                              "--f-number", "64", "-o", tmp_path(dir, "b"), "--quiet", NULL), 0);
+    cr_expect(!strstr(errtext, "diffraction"), "%s", errtext);
+    free(errtext);
+}
+
 /* Whether process pid is gone: no such process, or a zombie waiting for a reaper. */
 static bool process_gone(long pid)
 {

@@ -2,10 +2,12 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/random.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -53,23 +55,81 @@ int outfile_create_temp(const char *prefix, const char *suffix, char **path)
     return -1;
 }
 
-int outfile_check_path(const char *path, l2p_error *err)
+char *outfile_target(const char *path)
+{
+    char *p = strdup(path);
+    for (int links = 0; p; links++) {
+        struct stat sb;
+        if (lstat(p, &sb) != 0 || !S_ISLNK(sb.st_mode))
+            return p;
+        char to[PATH_MAX];
+        const ssize_t n = readlink(p, to, sizeof to - 1);
+        if (n < 0 || links == 40) {
+            free(p);
+            errno = n < 0 ? errno : ELOOP;
+            return NULL;
+        }
+        to[n] = '\0';
+        const char *slash = strrchr(p, '/');
+        char *next = to[0] == '/' || !slash ? strdup(to) : malloc((size_t)(slash - p) + 2 + (size_t)n);
+        if (next && to[0] != '/' && slash)
+            sprintf(next, "%.*s/%s", (int)(slash - p), p, to);
+        free(p);
+        p = next;
+    }
+    errno = ENOMEM;
+    return NULL;
+}
+
+int outfile_check_suffix(const char *path, const char *suffix, const char *format, l2p_error *err)
+{
+    const size_t n = strlen(path), k = strlen(suffix);
+    if (n > k && !strcasecmp(path + n - k, suffix))
+        return L2P_OK;
+    return l2p_fail(err, L2P_BAD_INPUT, path, 0, "this command writes %s: give a name ending in %s", format,
+                    suffix);
+}
+
+int outfile_check_not_input(const char *output, const char *input, const char *what, l2p_error *err)
+{
+    struct stat a, b;
+    if (stat(output, &a) != 0 || stat(input, &b) != 0 || a.st_dev != b.st_dev || a.st_ino != b.st_ino)
+        return L2P_OK;
+    return l2p_fail(err, L2P_BAD_INPUT, output, 0, "is %s (%s): an output would overwrite it; give "
+                    "another name", what, input);
+}
+
+static int check_target(const char *given, const char *path, l2p_error *err);
+
+int outfile_check_path(const char *given, l2p_error *err)
+{
+    if (!*given)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "an output file name is empty");
+    char *target = outfile_target(given);
+    if (!target)
+        return l2p_fail(err, errno == ENOMEM ? L2P_FAILED : L2P_BAD_INPUT, given, 0, "cannot write: %s",
+                        strerror(errno));
+    const int st = check_target(given, target, err);
+    free(target);
+    return st;
+}
+
+/* outfile_check_path for the target of the path given. */
+static int check_target(const char *given, const char *path, l2p_error *err)
 {
     struct stat sb;
-    if (!*path)
-        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "an output file name is empty");
     if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
-        return l2p_fail(err, L2P_BAD_INPUT, path, 0, "cannot write: Is a directory");
+        return l2p_fail(err, L2P_BAD_INPUT, given, 0, "cannot write: Is a directory");
     const char *slash = strrchr(path, '/');
     char *dir = slash ? strndup(path, (size_t)(slash - path) + 1) : strdup(".");
     if (!dir)
-        return l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
+        return l2p_fail(err, L2P_FAILED, given, 0, "out of memory");
     const char *why = stat(dir, &sb) != 0    ? strerror(errno)
                       : !S_ISDIR(sb.st_mode) ? strerror(ENOTDIR)
                       : access(dir, W_OK | X_OK) != 0 ? strerror(errno)
                                                        : NULL;
     free(dir);
-    return why ? l2p_fail(err, L2P_BAD_INPUT, path, 0, "cannot write: %s", why) : L2P_OK;
+    return why ? l2p_fail(err, L2P_BAD_INPUT, given, 0, "cannot write: %s", why) : L2P_OK;
 }
 
 int outfile_check_dir(const char *path, l2p_error *err)
@@ -88,14 +148,16 @@ int outfile_check_dir(const char *path, l2p_error *err)
 int outfile_open(outfile *f, const char *path, l2p_error *err)
 {
     memset(f, 0, sizeof *f);
-    char *prefix = malloc(strlen(path) + 5);
-    f->final_path = strdup(path);
-    if (!f->final_path || !prefix) {
-        free(prefix);
+    f->final_path = outfile_target(path);
+    if (!f->final_path)
+        return l2p_fail(err, errno == ENOMEM ? L2P_FAILED : L2P_BAD_INPUT, path, 0, "cannot write: %s",
+                        strerror(errno));
+    char *prefix = malloc(strlen(f->final_path) + 5);
+    if (!prefix) {
         outfile_discard(f);
         return l2p_fail(err, L2P_FAILED, path, 0, "out of memory");
     }
-    strcpy(prefix, path);
+    strcpy(prefix, f->final_path);
     strcat(prefix, ".tmp");
     const int fd = outfile_create_temp(prefix, "", &f->temp_path);
     free(prefix);

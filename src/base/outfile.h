@@ -24,6 +24,20 @@ typedef struct outfile {
    (close-on-exec) with its name in *path (malloc'd), or -1 with errno set. */
 int outfile_create_temp(const char *prefix, const char *suffix, char **path);
 
+/* The file an output named path goes to: path itself, or where its chain of symbolic links
+   ends (a link's relative target is read from the link's folder), so that an output named by
+   a link is written through it and the link stays, as with any program that opens the file.
+   malloc'd; NULL with errno set (ELOOP after 40 links, ENOMEM). */
+char *outfile_target(const char *path);
+
+/* Refuses (L2P_BAD_INPUT) an output whose name does not end in suffix (any case), for a
+   command that writes only format, so that the name does not lie about the file. */
+int outfile_check_suffix(const char *path, const char *suffix, const char *format, l2p_error *err);
+
+/* Refuses (L2P_BAD_INPUT, naming both) an output that is the input file read as what (its
+   role, "the lens"): the same file, by any name or link. Either may not exist yet. */
+int outfile_check_not_input(const char *output, const char *input, const char *what, l2p_error *err);
+
 /* Checks, before any work, that path can become an output: its folder exists and may be
    written, and path is not a folder. L2P_BAD_INPUT with a message naming path otherwise. */
 int outfile_check_path(const char *path, l2p_error *err);
@@ -32,7 +46,8 @@ int outfile_check_path(const char *path, l2p_error *err);
    written, a new one's parent must exist and may be written. */
 int outfile_check_dir(const char *path, l2p_error *err);
 
-/* Opens a temporary file beside path for writing (outfile_create_temp, "PATH.tmp..."). */
+/* Opens a temporary file beside path's target (outfile_target) for writing
+   (outfile_create_temp, "TARGET.tmp..."); final_path is the target. */
 int outfile_open(outfile *f, const char *path, l2p_error *err);
 
 /* Flushes and closes the temporary file (checking for write errors) without renaming it. */

@@ -1,4 +1,6 @@
 #include "cli/cli.h"
+
+#include "base/outfile.h"
 #include "cli/values.h"
 #include "field/field_render.h"
 
@@ -314,6 +316,40 @@ static bool same_output(const char *rays, const char *output)
     return false;
 }
 
+/* What positional argument i of command is, for a message. */
+static const char *input_role(const char *command, int i)
+{
+    if (!strcmp(command, "render"))
+        return i == 0 ? "the scene" : "the lens";
+    if (!strcmp(command, "develop"))
+        return i == 0 ? "the ray table" : "a render";
+    return "the lens";
+}
+
+/* No output may be an input: the positional files (lens, scene, renders), --scene. trace's -o
+   is a prefix of PREFIX.inc, .ini and .map. */
+static int check_outputs_not_inputs(const cli *c, const char *command, l2p_error *err)
+{
+    const bool prefix = !strcmp(command, "trace");
+    const char *ext[] = {"", ".inc", ".ini", ".map"};
+    int st = L2P_OK;
+    for (int k = 0; !st && k < 5; k++) {
+        const char *base = k < 4 ? c->output : c->rays_csv;
+        if (!base || (k < 4 && (prefix ? k == 0 : k > 0)))
+            continue;
+        char *out = malloc(strlen(base) + 5);
+        if (!out)
+            return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+        sprintf(out, "%s%s", base, k < 4 ? ext[k] : "");
+        for (int i = 0; !st && i < c->positional_count; i++)
+            st = outfile_check_not_input(out, c->positional[i], input_role(command, i), err);
+        if (!st && c->scene)
+            st = outfile_check_not_input(out, c->scene, "the scene", err);
+        free(out);
+    }
+    return st;
+}
+
 static int check_contradictions(const cli *c, l2p_error *err)
 {
     const camera_options *o = &c->cam;
@@ -433,7 +469,8 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
         if (st)
             return st;
     }
-    return check_contradictions(c, err);
+    int st = check_contradictions(c, err);
+    return st ? st : check_outputs_not_inputs(c, argv[first - 1], err);
 }
 
 void cli_print_options(FILE *out, const char *command)
@@ -462,8 +499,18 @@ void cli_warn(const cli *c, const camera *cam)
                 -cam->focus_distance_units);
     if (c->cam.pupil == PUPIL_STOP && c->cam.trace == TRACE_KIND_FULL)
         fprintf(stderr, "lens2pov: warning: --pupil stop aims at the stop's own disk, which misses "
-                        "rays the lens passes: the picture comes out too dark (a diagnostic; "
-                        "stop-image and rear are unbiased)\n");
+                        "rays the lens passes and holds rays it blocks: the picture is biased (with "
+                        "normalized weights the lens's vignetting is lost, too bright off the axis; "
+                        "with physical ones too dark; a diagnostic: stop-image and rear are "
+                        "unbiased)\n");
+    /* Rays leave out diffraction: through a stop this small it would blur every point over the
+       Airy disk, 2.44 lambda N across (lambda 550 nm), more than 1% of the film's diagonal. */
+    const double airy_mm = 2.44 * 550e-6 * cam->f_number;
+    if (airy_mm > 0.01 * cam->film.diagonal_mm)
+        fprintf(stderr, "lens2pov: warning: at f/%.4g diffraction, which ray tracing leaves out, would "
+                        "blur every point over %.3g mm (the Airy disk, 2.44 lambda N at 550 nm), "
+                        "%.0f pixels: the picture is not what this lens would take\n", cam->f_number,
+                airy_mm, airy_mm / (cam->film.width_mm / cam->film.width));
 }
 
 int cli_expect_arguments(const cli *c, int positional, bool output, l2p_error *err)

@@ -33,6 +33,16 @@ static char **render_names(const cli *c, long long chunks, l2p_error *err)
     return names;
 }
 
+/* The picture must not replace the map or a render it is developed from. */
+static int check_inputs(const cli *c, const char *map_path, char *const *renders, long long count,
+                        l2p_error *err)
+{
+    int st = outfile_check_not_input(c->output, map_path, "the sample map", err);
+    for (long long k = 0; !st && k < count; k++)
+        st = outfile_check_not_input(c->output, renders[k], "a render to develop", err);
+    return st;
+}
+
 /* A field map's renders: as given, or PREFIX.f000.exr, PREFIX.f001.exr, ... (the names its
    .ini files give POV-Ray). */
 static int develop_field(const cli *c, const char *map_path, l2p_error *err)
@@ -55,7 +65,7 @@ static int develop_field(const cli *c, const char *map_path, l2p_error *err)
     }
     if (!names || (m.renders && !names[m.renders - 1]))
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    else
+    else if (!(st = check_inputs(c, map_path, names, m.renders, err)))
         st = field_develop(&m, (const char *const *)names, given ? given : m.renders, c->output,
                            err);
     for (int r = 0; names && r < m.renders; r++)
@@ -83,15 +93,17 @@ int develop_command(const cli *c, l2p_error *err)
     }
     samplemap map;
     st = samplemap_read(map_path, &map, err);
-    free(map_path);
-    if (st)
+    if (st) {
+        free(map_path);
         return st;
+    }
     const long long chunks = samplemap_chunk_count(&map.header);
     char **names = render_names(c, chunks, err);
-    if (names)
-        st = develop_files(&map, (const char *const *)names, (int)chunks, c->output, err);
-    else
+    if (!names)
         st = err->status;
+    else if (!(st = check_inputs(c, map_path, names, chunks, err)))
+        st = develop_files(&map, (const char *const *)names, (int)chunks, c->output, err);
+    free(map_path);
     for (long long k = 0; names && k < chunks; k++)
         free(names[k]);
     free(names);

@@ -9,7 +9,7 @@ int diagram_command(const cli *c, l2p_error *err)
 {
     int st = cli_expect_arguments(c, 1, true, err);
     camera cam;
-    if (st || (st = outfile_check_path(c->output, err)) ||
+    if (st || (st = outfile_check_suffix(c->output, ".svg", "SVG", err)) || (st = outfile_check_path(c->output, err)) ||
         (st = framing_load_camera(c, c->positional[0], &cam, err)))
         return st;
     cli_warn(c, &cam);

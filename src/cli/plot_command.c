@@ -149,7 +149,7 @@ int plot_command(const cli *c, l2p_error *err)
     if (!vignetting && strcmp(c->what, "distortion"))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--what: expected distortion or vignetting, got '%s'", c->what);
-    if ((st = outfile_check_path(c->output, err)))
+    if ((st = outfile_check_suffix(c->output, ".png", "PNG", err)) || (st = outfile_check_path(c->output, err)))
         return st;
     plot_job *j = calloc(1, sizeof *j);
     if (!j)

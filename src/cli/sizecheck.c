@@ -52,8 +52,10 @@ static size_estimate pixel_estimate(const cli *c, int jobs)
     e.table_bytes = faces * (SIZE_INCLUDE_BYTES_PER_FACE + SIZE_MAP_BYTES_PER_FACE) + 8192.0;
     e.csv_bytes = c->rays_csv ? faces * SIZE_CSV_BYTES_PER_FACE : 0.0;
     if (jobs > 0) {
-        e.renders_bytes = faces * SIZE_EXR_BYTES_PER_FACE;
         render_memory(c, faces, pixels, jobs, &e);
+        const double budget = (double)raytable_faces_for_memory(c->memory_mb);
+        const double chunk_faces = fmin(faces, budget), at_once = fmin(jobs, ceil(faces / budget));
+        e.renders_bytes = faces * SIZE_EXR_BYTES_PER_FACE + at_once * chunk_faces * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
     }
     return e;
 }
@@ -137,7 +139,8 @@ static size_estimate field_estimate(const cli *c, int jobs)
                     l.spp * (SIZE_FIELD_RENDER_FILES_BYTES + l.pixels * sizeof(float));
     e.csv_bytes = c->rays_csv ? l.spp * l.pixels * SIZE_FIELD_CSV_BYTES_PER_ROW : 0.0;
     if (jobs > 0) {
-        e.renders_bytes = l.spp * l.subimage_pixels * SIZE_EXR_BYTES_PER_FACE;
+        e.renders_bytes = l.spp * l.subimage_pixels * SIZE_EXR_BYTES_PER_FACE +
+                          l.at_once * l.render_pixels * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
         field_memory(&l, jobs, &e);
     }
     return e;

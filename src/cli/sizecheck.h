@@ -17,6 +17,9 @@
 #define SIZE_MAP_BYTES_PER_FACE 16.0
 #define SIZE_CSV_BYTES_PER_FACE 230.0
 #define SIZE_EXR_BYTES_PER_FACE 8.0
+/* POV-Ray's .pov-state beside a render in progress, which holds the blocks rendered so far (five
+   floats a pixel; 118 MB for 6 M rendered pixels measured) until the render ends. */
+#define SIZE_POVRAY_STATE_BYTES_PER_PIXEL 20.0
 
 /* Field sampling, from real renders of the four lenses (rounded up; docs/fields.md): a
    sub-image's faces at the default tolerance for each pixel of the crop's width plus height,
@@ -40,7 +43,8 @@ typedef struct size_estimate {
     double faces;                 /* at most (field sampling: estimated) */
     double table_bytes;           /* include, ini and sample map; field: includes, inis, weights */
     double csv_bytes;             /* --rays, 0 without */
-    double renders_bytes;         /* render: the chunks' (field: the renders') EXR files */
+    double renders_bytes;         /* render: the chunks' (field: the renders') EXR files, and
+                                     POV-Ray's state files of the renders at once */
     double memory_bytes;          /* render: POV-Ray's processes at once, or lens2pov's own work */
     double povray_process_bytes;  /* render: one POV-Ray process, at most */
     bool csv_in_workspace;        /* the CSV is written in the workspace, then moved to --rays */

@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include "base/cleanup.h"
 #include "optics/irradiance.h"
+#include "optics/pupil.h"
 
 static double film_radius(const camera *c, int row)
 {
@@ -55,22 +56,32 @@ void plot_distortion_table(FILE *out, const camera *c)
     }
 }
 
+/* E at film radius r through camera c: the full lens's passing directions, or with --trace
+   thick its exit pupil, the stop's image, which is all a thick lens stops. */
+static double irradiance_of(const camera *c, double r)
+{
+    double z, radius;
+    if (c->trace == TRACE_KIND_THICK && pupil_stop_image(&c->lens, true, &z, &radius, NULL) == L2P_OK)
+        return irradiance_through_disk(r, z, radius);
+    return irradiance_at(&c->lens, v3(0, r, 0), PLOT_IRRADIANCE_GRID);
+}
+
 void plot_vignetting_table(FILE *out, const camera *const *cams, int count)
 {
     double e0[8];
-    fprintf(out, "# %s: relative illumination E(r)/E(0) from the lens's passing directions\n"
-                 "# film_radius_mm", cams[0]->lens.name);
+    fprintf(out, "# %s: relative illumination E(r)/E(0) %s\n# film_radius_mm", cams[0]->lens.name,
+            cams[0]->trace == TRACE_KIND_THICK ? "through the thick lens's exit pupil (--trace thick)"
+                                               : "from the lens's passing directions");
     for (int i = 0; i < count && i < 8; i++) {
         fprintf(out, " f/%.3g", cams[i]->f_number);
-        e0[i] = irradiance_at(&cams[i]->lens, v3(0, 0, 0), PLOT_IRRADIANCE_GRID);
+        e0[i] = irradiance_of(cams[i], 0.0);
     }
     fputc('\n', out);
     for (int row = 0; row < PLOT_ROWS; row++) {
         const double r = film_radius(cams[0], row);
         fprintf(out, "%.9g", r);
         for (int i = 0; i < count && i < 8; i++)
-            fprintf(out, " %.9g", row == 0 ? 1.0
-                                  : irradiance_at(&cams[i]->lens, v3(0, r, 0), PLOT_IRRADIANCE_GRID) / e0[i]);
+            fprintf(out, " %.9g", row == 0 ? 1.0 : irradiance_of(cams[i], r) / e0[i]);
         fputc('\n', out);
     }
 }

@@ -22,7 +22,8 @@ enum { PLOT_WIDTH_PX = 800, PLOT_HEIGHT_PX = 500 };
 void plot_distortion_table(FILE *out, const camera *c);
 
 /* Writes E(r)/E(0) for each camera (the same lens at several f-numbers), one column each:
-   irradiance_at (optics/irradiance.h) at film point (0, r). */
+   irradiance_at (optics/irradiance.h) at film point (0, r), or with --trace thick
+   irradiance_through_disk of the exit pupil. */
 void plot_vignetting_table(FILE *out, const camera *const *cams, int count);
 
 /* Draws table (a file of folder dir written by one of the above, named relative to dir) with

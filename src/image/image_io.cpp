@@ -346,13 +346,19 @@ int write_rgb(const char *path, int width, int height, const float *pixels,
                         "unknown image type '%s' (use .png, .exr or .tif)", ext.c_str());
     if (width <= 0 || height <= 0 || !pixels)
         return l2p_fail(err, L2P_FAILED, path, 0, "no pixels to write (%dx%d)", width, height);
-    int st = check_folder(path, err);
+    char *to = outfile_target(path);   // written through a symbolic link, which stays
+    if (!to)
+        return fail(err, errno == ENOMEM ? L2P_FAILED : L2P_BAD_INPUT, path,
+                    std::string("cannot write: ") + std::strerror(errno));
+    const std::string target = to;
+    std::free(to);
+    int st = check_folder(target, err);
     if (st)
         return st;
     ImageSpec spec = make_spec(kind, width, height);
     add_attributes(spec, attributes, attribute_count);
     std::string temp;
-    if ((st = make_temp(path, ext, temp, err)))
+    if ((st = make_temp(target, ext, temp, err)))
         return st;
     cleanup_track(temp.c_str());
     try {
@@ -362,7 +368,7 @@ int write_rgb(const char *path, int width, int height, const float *pixels,
         cleanup_untrack(temp.c_str());
         throw;
     }
-    if (!st && std::rename(temp.c_str(), path) != 0)
+    if (!st && std::rename(temp.c_str(), target.c_str()) != 0)
         st = fail(err, L2P_FAILED, path, std::string("cannot rename into place: ") +
                                              std::strerror(errno));
     if (st)

@@ -60,3 +60,10 @@ double irradiance_at(const lens *l, vec3 p, int n)
     double unused[4] = {1, -1, 1, -1};
     return (double)count_passing(l, p, &fine, unused) * fine.h * fine.h;
 }
+
+double irradiance_through_disk(double r_mm, double z_mm, double radius_mm)
+{
+    const double z2 = z_mm * z_mm, r2 = r_mm * r_mm, R2 = radius_mm * radius_mm;
+    const double s = z2 + r2 + R2;
+    return 0.5 * M_PI * (1.0 - (z2 + r2 - R2) / sqrt(s * s - 4.0 * r2 * R2));
+}

@@ -13,4 +13,11 @@
    measures it. 0 when no direction passes. */
 double irradiance_at(const lens *l, vec3 p, int n);
 
+/* E for a background of radiance 1 at a film point r from the axis, seen through a disk of
+   radius R standing Z in front of the film, centred on the axis and parallel to it (a thick
+   lens's exit pupil, which blocks nothing else): the projected solid angle of the disk,
+   (pi / 2) (1 - (Z^2 + r^2 - R^2) / sqrt((Z^2 + r^2 + R^2)^2 - 4 r^2 R^2)) (the view factor of
+   a disk to a parallel element off its axis; pi R^2 / (Z^2 + R^2) on it). */
+double irradiance_through_disk(double r_mm, double z_mm, double radius_mm);
+
 #endif

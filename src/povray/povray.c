@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -215,8 +216,9 @@ static void draw_progress(run *r, int finished)
         }
         povray_log_progress(j->log_path, r->chunks[job_chunk(r, j)].faces, &j->parse_fraction,
                             &j->render_fraction);
-        sum += (j->frame > 1 ? j->frame - 1 : 0) + 0.5 * j->parse_fraction +
-               0.5 * j->render_fraction;
+        /* a frame whose pixels are all rendered is not done until its picture is written */
+        sum += (j->frame > 1 ? j->frame - 1 : 0) + fmin(0.99, 0.5 * j->parse_fraction +
+                                                            0.5 * j->render_fraction);
         running++;
     }
     char detail[64];
