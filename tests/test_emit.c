@@ -312,6 +312,17 @@ Test(emit, the_widest_f_number_as_printed_opens_the_stop_fully)
     }
 }
 
+/* An aperture a hair wider than the stop is refused with both numbers as given, so that the
+   message does not read "17.1 is not in (0, 17.1]". */
+Test(emit, an_aperture_a_hair_too_wide_is_refused_in_full_digits)
+{
+    char *errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "info", LENS_DIR "dgauss.50mm.dat", "--aperture-diameter",
+                              "17.1000001", NULL), 2);
+    cr_assert(strstr(errtext, "17.1000001 mm is not in (0, 17.1]"), "%s", errtext);
+    free(errtext);
+}
+
 /* A film distance shorter than the rear focal distance images a virtual object behind the film:
    trace warns that nothing is sharp, and says nothing for a film beyond the focal plane. The
    focal plane from info (back focal distance), not from the warning's arithmetic. */

@@ -288,6 +288,16 @@ Test(lens, line_numbers_in_a_crlf_file)
     REFUSED("# header\r\n\r\n10 2 1.5 8\r\n0 1 0 4\r\n\r\n# x\r\n-10 5 1\r\n", 7, "got 3");
 }
 
+/* Rows ended by CR alone (old Mac files) read as one line: said so, not "unexpected '-10'
+   after the 5 numbers". A CR in a comment, or before blanks and the LF, is no such thing. */
+Test(lens, cr_only_line_endings_are_named)
+{
+    REFUSED("10 2 1.5 8\r0 1 0 4\r-10 5 1 8\r", 1, "carriage return (CR) inside the line");
+    lens l = parsed("# a comment\rwith a CR\n10 2 1.5 8 \r \n0 1 0 4\r\n-10 5 1 8\r\n");
+    expect_minimal(&l);
+    lens_free(&l);
+}
+
 /* ---- awkward but valid files ------------------------------------------------------------ */
 
 Test(lens, crlf)
@@ -404,6 +414,9 @@ Test(lens, abbe_number_of_glass_must_be_positive)
     REFUSED("10 2 1.5 8 nan\n" STOP REAR, 1, "not a finite number: 'nan'");
     REFUSED("10 2 1.5 8 inf\n" STOP REAR, 1, "not a finite number: 'inf'");
     REFUSED("10 2 1.5 8 1e999\n" STOP REAR, 1, "out of range");
+    /* below 5 no optical material disperses (below 0.66 the Cauchy fit's index falls under 1) */
+    REFUSED("10 2 1.5 8 0.01\n" STOP REAR, 1, "Abbe number 0.01 disperses more than any optical material");
+    REFUSED("10 2 1.5 8 1e-300\n" STOP REAR, 1, "Abbe number 1e-300 disperses");
 }
 
 Test(lens, abbe_numbers_on_every_glass_row_or_none)

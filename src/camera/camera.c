@@ -89,7 +89,7 @@ static int setup_aperture(lens *l, const camera_options *o, double efl_mm, l2p_e
     }
     if (!(diameter > 0.0) || diameter > full * (1.0 + 1e-12))
         return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[l->stop].line,
-                        "aperture diameter %g mm is not in (0, %g], the stop's opening",
+                        "aperture diameter %.9g mm is not in (0, %.9g], the stop's opening",
                         diameter, full);
     l->stop_diameter_mm = fmin(diameter, full);
     return L2P_OK;

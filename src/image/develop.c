@@ -13,7 +13,8 @@ static long long crop_width(const samplemap_header *h) { return h->crop_x1 - h->
 static long long crop_height(const samplemap_header *h) { return h->crop_y1 - h->crop_y0; }
 
 /* The chunk's image must be exactly packed_width x (face rows + 1): anything else means the
-   render does not belong to this map (or POV-Ray was run with other settings). */
+   render does not belong to this map (or POV-Ray was run with other settings), the input's
+   fault (L2P_BAD_INPUT, as field_develop says of a field render). */
 static int check_chunk_image(const samplemap_header *h, long long chunk, int width, int height,
                              l2p_error *err)
 {
@@ -23,7 +24,7 @@ static int check_chunk_image(const samplemap_header *h, long long chunk, int wid
                         chunk, count);
     const int rows = samplemap_chunk_rows(h, chunk);
     if (width != h->packed_width || height != rows + 1)
-        return l2p_fail(err, L2P_FAILED, NULL, 0,
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "render of chunk %lld is %dx%d, expected %dx%d (packed width x face "
                         "rows + 1): it does not belong to this sample map",
                         chunk, width, height, h->packed_width, rows + 1);

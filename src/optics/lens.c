@@ -105,6 +105,14 @@ static int parse_line(const where *w, const char *p, const char *eol, row *r, in
     const char *data_end = memchr(p, '#', (size_t)(eol - p));
     if (!data_end)
         data_end = eol;
+    /* a CR inside a line (not the CR of CRLF) ends rows in old Mac files, which read as one line */
+    const char *cr = memchr(p, '\r', (size_t)(data_end - p)), *after = cr;
+    while (after && after < data_end && is_blank(*after))
+        after++;
+    if (cr && after < data_end)
+        return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
+                        "a carriage return (CR) inside the line: rows end with CR alone, as in old "
+                        "Mac files; convert the line endings to LF");
     int n = 0;
     for (;;) {
         while (p < data_end && is_blank(*p))
@@ -178,7 +186,11 @@ static int row_is_air(const row *r)
 }
 
 /* The Abbe number of one row, on its own: 0 on air (like the index column's 0 on the stop),
-   positive behind glass. Not finite was refused with the number. */
+   at least LENS_ABBE_LEAST behind glass. Not finite was refused with the number. Below about
+   0.66 the Cauchy fit (docs/lenses.md) puts the index below 1 within 380-780 nm; no optical
+   material comes near 5. */
+#define LENS_ABBE_LEAST 5.0
+
 static int check_abbe(const where *w, const row *r)
 {
     if (r->count < 5)
@@ -192,6 +204,11 @@ static int check_abbe(const where *w, const row *r)
         return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
                         "Abbe number of the glass behind the surface must be positive, got %.*s",
                         r->text_length[4], r->text[4]);
+    if (!row_is_air(r) && abbe < LENS_ABBE_LEAST)
+        return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line,
+                        "Abbe number %.*s disperses more than any optical material (glasses lie "
+                        "between about 17 and 95; at least %g here): a typo?",
+                        r->text_length[4], r->text[4], LENS_ABBE_LEAST);
     return L2P_OK;
 }
 
