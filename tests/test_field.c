@@ -69,6 +69,24 @@ Test(field, seeds_scramble_the_samples)
 #include <stdio.h>
 #include "field/subimage.h"
 
+/* Builds the sub-image of camera c seen with shared sample s into m (at the crop's render
+   size), writes its include and reads it back through the model into pm. */
+static void build_and_read_back(const camera *c, film_sample s, const field_tolerance *t, field_mesh *m,
+                                field_stats *st, povuv_mesh *pm)
+{
+    field_mesh_init(m, field_render_size(c->crop_x1 - c->crop_x0), field_render_size(c->crop_y1 - c->crop_y0));
+    l2p_error err;
+    cr_assert_eq(field_build_subimage(c, s, t, FIELD_COARSEST_CELL, m, NULL, st, &err), L2P_OK, "%s", err.text);
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    cr_assert_eq(field_mesh_write_include(f, m, "Field_Test", world, NULL), 0);
+    fclose(f);
+    read_field_include(text, pm);
+    free(text);
+}
+
 /* Builds the sub-image of shared sample k, writes its include, reads it back through the
    model, and checks every pixel of the crop against its exact traced ray. */
 static void check_subimage(const char *lens, camera_options *o, double tol, uint32_t k, field_stats *st)
@@ -80,17 +98,8 @@ static void check_subimage(const char *lens, camera_options *o, double tol, uint
     const int w = c.crop_x1 - c.crop_x0, h = c.crop_y1 - c.crop_y0;
     film_sample s = sobol_shared_sample(o->seed, k);
     field_mesh m;
-    field_mesh_init(&m, field_render_size(w), field_render_size(h));
-    l2p_error err;
-    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_COARSEST_CELL, &m, NULL, st, &err), L2P_OK, "%s", err.text);
-    char *text = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&text, &len);
-    static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Test", world, NULL), 0);
-    fclose(f);
     povuv_mesh pm;
-    read_field_include(text, &pm);
+    build_and_read_back(&c, s, &t, &m, st, &pm);
     const double front = c.lens.surface[0].vertex_z_mm;
     long rendered = 0, passed = 0;
     double worst = 0, affine_apart = 0;
@@ -133,7 +142,6 @@ static void check_subimage(const char *lens, camera_options *o, double tol, uint
                   lens, affine_apart);
     cr_expect_eq(passed, st->passed);
     cr_expect(rendered == passed);
-    free(text);
     povuv_mesh_free(&pm);
     field_mesh_free(&m);
     camera_free(&c);
@@ -283,17 +291,8 @@ Test(field, a_model_ray_lands_within_the_tolerance_on_the_film)
     const film_sample s = sobol_shared_sample(o.seed, 1);
     field_mesh m;
     field_stats st;
-    l2p_error err;
-    field_mesh_init(&m, field_render_size(w), field_render_size(h));
-    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_COARSEST_CELL, &m, NULL, &st, &err), L2P_OK, "%s", err.text);
-    char *text = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&text, &len);
-    static const double world[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-    cr_assert_eq(field_mesh_write_include(f, &m, "Field_Test", world, NULL), 0);
-    fclose(f);
     povuv_mesh pm;
-    read_field_include(text, &pm);
+    build_and_read_back(&c, s, &t, &m, &st, &pm);
     double worst = 0, worst_centre_angle = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -315,7 +314,6 @@ Test(field, a_model_ray_lands_within_the_tolerance_on_the_film)
     cr_log_info("wide.22mm: %d faces, the model's rays land at most %.4f px from their pixels (%.4f px in "
                 "the centre's angle)", st.faces, worst, worst_centre_angle);
     cr_assert_leq(worst, 0.05 * 1.01, "a ray lands %g px from its pixel", worst);
-    free(text);
     povuv_mesh_free(&pm);
     field_mesh_free(&m);
     camera_free(&c);

@@ -99,21 +99,6 @@ int outfile_check_not_input(const char *output, const char *input, const char *w
                     "another name", what, input);
 }
 
-static int check_target(const char *given, const char *path, l2p_error *err);
-
-int outfile_check_path(const char *given, l2p_error *err)
-{
-    if (!*given)
-        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "an output file name is empty");
-    char *target = outfile_target(given);
-    if (!target)
-        return l2p_fail(err, errno == ENOMEM ? L2P_FAILED : L2P_BAD_INPUT, given, 0, "cannot write: %s",
-                        strerror(errno));
-    const int st = check_target(given, target, err);
-    free(target);
-    return st;
-}
-
 /* outfile_check_path for the target of the path given. */
 static int check_target(const char *given, const char *path, l2p_error *err)
 {
@@ -130,6 +115,19 @@ static int check_target(const char *given, const char *path, l2p_error *err)
                                                        : NULL;
     free(dir);
     return why ? l2p_fail(err, L2P_BAD_INPUT, given, 0, "cannot write: %s", why) : L2P_OK;
+}
+
+int outfile_check_path(const char *given, l2p_error *err)
+{
+    if (!*given)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "an output file name is empty");
+    char *target = outfile_target(given);
+    if (!target)
+        return l2p_fail(err, errno == ENOMEM ? L2P_FAILED : L2P_BAD_INPUT, given, 0, "cannot write: %s",
+                        strerror(errno));
+    const int st = check_target(given, target, err);
+    free(target);
+    return st;
 }
 
 int outfile_check_dir(const char *path, l2p_error *err)

@@ -326,27 +326,34 @@ static const char *input_role(const char *command, int i)
     return "the lens";
 }
 
-/* No output may be an input: the positional files (lens, scene, renders), --scene. trace's -o
-   is a prefix of PREFIX.inc, .ini and .map. */
+/* Output out must not be an input: the positional files (lens, scene, renders), --scene. */
+static int check_not_input(const cli *c, const char *command, const char *out, l2p_error *err)
+{
+    int st = L2P_OK;
+    for (int i = 0; !st && i < c->positional_count; i++)
+        st = outfile_check_not_input(out, c->positional[i], input_role(command, i), err);
+    if (!st && c->scene)
+        st = outfile_check_not_input(out, c->scene, "the scene", err);
+    return st;
+}
+
+/* No output may be an input: -o (for trace a prefix of PREFIX.inc, .ini and .map) and --rays. */
 static int check_outputs_not_inputs(const cli *c, const char *command, l2p_error *err)
 {
-    const bool prefix = !strcmp(command, "trace");
-    const char *ext[] = {"", ".inc", ".ini", ".map"};
-    int st = L2P_OK;
-    for (int k = 0; !st && k < 5; k++) {
-        const char *base = k < 4 ? c->output : c->rays_csv;
-        if (!base || (k < 4 && (prefix ? k == 0 : k > 0)))
-            continue;
-        char *out = malloc(strlen(base) + 5);
-        if (!out)
-            return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-        sprintf(out, "%s%s", base, k < 4 ? ext[k] : "");
-        for (int i = 0; !st && i < c->positional_count; i++)
-            st = outfile_check_not_input(out, c->positional[i], input_role(command, i), err);
-        if (!st && c->scene)
-            st = outfile_check_not_input(out, c->scene, "the scene", err);
-        free(out);
+    int st = c->rays_csv ? check_not_input(c, command, c->rays_csv, err) : L2P_OK;
+    if (st || !c->output)
+        return st;
+    if (strcmp(command, "trace"))
+        return check_not_input(c, command, c->output, err);
+    static const char *const ext[] = {".inc", ".ini", ".map"};
+    char *out = malloc(strlen(c->output) + 5);
+    if (!out)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; !st && k < 3; k++) {
+        sprintf(out, "%s%s", c->output, ext[k]);
+        st = check_not_input(c, command, out, err);
     }
+    free(out);
     return st;
 }
 

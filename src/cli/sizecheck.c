@@ -30,13 +30,15 @@ static double crop_pixels(const camera_options *o)
 }
 
 /* POV-Ray's processes at once, their chunks cut as render cuts them (chunk_faces_for), or
-   developing after them, whichever takes more. */
-static void render_memory(const cli *c, double faces, double pixels, int jobs, size_estimate *e)
+   developing after them, whichever takes more; on disk the chunks' EXRs and the state files of
+   the chunks at once. */
+static void render_sizes(const cli *c, double faces, double pixels, int jobs, size_estimate *e)
 {
     const double budget = (double)raytable_faces_for_memory(c->memory_mb);
     const double chunks = jobs * ceil(ceil(faces / budget) / jobs);
     const double chunk_faces = faces / chunks;
     const double at_once = chunks < jobs ? chunks : jobs;
+    e->renders_bytes = faces * SIZE_EXR_BYTES_PER_FACE + at_once * chunk_faces * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
     e->povray_process_bytes = chunk_faces * RAYTABLE_POVRAY_BYTES_PER_FACE + POVRAY_BASE_BYTES;
     const double povray = at_once * e->povray_process_bytes;
     const double develop = faces * SIZE_MAP_BYTES_PER_FACE + chunk_faces * 16.0 +
@@ -51,12 +53,8 @@ static size_estimate pixel_estimate(const cli *c, int jobs)
     size_estimate e = {.faces = faces, .csv_in_workspace = jobs > 0};
     e.table_bytes = faces * (SIZE_INCLUDE_BYTES_PER_FACE + SIZE_MAP_BYTES_PER_FACE) + 8192.0;
     e.csv_bytes = c->rays_csv ? faces * SIZE_CSV_BYTES_PER_FACE : 0.0;
-    if (jobs > 0) {
-        render_memory(c, faces, pixels, jobs, &e);
-        const double budget = (double)raytable_faces_for_memory(c->memory_mb);
-        const double chunk_faces = fmin(faces, budget), at_once = fmin(jobs, ceil(faces / budget));
-        e.renders_bytes = faces * SIZE_EXR_BYTES_PER_FACE + at_once * chunk_faces * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
-    }
+    if (jobs > 0)
+        render_sizes(c, faces, pixels, jobs, &e);
     return e;
 }
 
