@@ -76,7 +76,7 @@ static void build_and_read_back(const camera *c, film_sample s, const field_tole
 {
     field_mesh_init(m, field_render_size(c->crop_x1 - c->crop_x0), field_render_size(c->crop_y1 - c->crop_y0));
     l2p_error err;
-    cr_assert_eq(field_build_subimage(c, s, t, FIELD_COARSEST_CELL, m, NULL, st, &err), L2P_OK, "%s", err.text);
+    cr_assert_eq(field_build_subimage(c, s, 1.0, t, FIELD_COARSEST_CELL, m, NULL, st, &err), L2P_OK, "%s", err.text);
     char *text = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);
@@ -338,7 +338,7 @@ Test(field, sub_images_moved_into_a_render_keep_their_rays)
         field_stats st;
         l2p_error err;
         field_mesh_init(&m, field_render_size(w), field_render_size(h));
-        cr_assert_eq(field_build_subimage(&c, sobol_shared_sample(o.seed, (uint32_t)k), &t, FIELD_COARSEST_CELL,
+        cr_assert_eq(field_build_subimage(&c, sobol_shared_sample(o.seed, (uint32_t)k), 1.0, &t, FIELD_COARSEST_CELL,
                                           &m, NULL, &st, &err), L2P_OK);
         cr_assert_eq(field_mesh_append(&render, &m, dx[k], 0), 0);
         field_mesh_free(&m);

@@ -153,7 +153,7 @@ Test(field_povray, povray_renders_a_lens_field_within_the_tolerance)
     field_stats st;
     l2p_error err;
     field_mesh_init(&m, rw, rh);
-    cr_assert_eq(field_build_subimage(&c, s, &t, FIELD_COARSEST_CELL, &m, NULL, &st, &err), L2P_OK);
+    cr_assert_eq(field_build_subimage(&c, s, 1.0, &t, FIELD_COARSEST_CELL, &m, NULL, &st, &err), L2P_OK);
     /* mesh space (camera space less the front vertex) to the world, as field_render.c does */
     const double front = c.lens.surface[0].vertex_z_mm;
     vec3 ax[3] = {camera_world_from_camera_offset(&c, v3(1, 0, 0)), camera_world_from_camera_offset(&c, v3(0, 1, 0)),

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "field/sobol.h"
+#include "field/strata.h"
 #include "field/subimage.h"
 #include "image/image_io.h"
 #include "support.h"
@@ -57,7 +58,8 @@ static bool same_vec(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z ==
    with the shared sample, passes the lens (and whose film point the lens reaches), and none
    for the others; each row holds that ray. The CSV prints %.17g, which reads back exactly,
    and the batch tracer that made it agrees bit for bit with camera_trace (tests/test_trace.c),
-   so the values must be equal. */
+   so the values must be equal; the weight is the trace's times its sub-image's stratum factor
+   (src/field/strata.c). */
 Test(field_rays, the_rows_are_the_passing_pixels_with_their_exact_rays)
 {
     const char *dir = test_tmpdir();
@@ -66,9 +68,12 @@ Test(field_rays, the_rows_are_the_passing_pixels_with_their_exact_rays)
     camera_options o = options();
     camera c;
     test_camera(&c, "fisheye.10mm", &o);
+    field_strata t;
+    field_strata_count(&c, &t);
     size_t next = 0, blocked = 0;
     for (uint32_t k = 0; k < SPP; k++) {
         const film_sample s = sobol_shared_sample(SEED, k);
+        const double scale = field_strata_scale(&t, &c, s);   /* the sub-image's stratum */
         for (int y = CROP_Y0; y < CROP_Y1; y++)
             for (int x = CROP_X0; x < CROP_X1; x++) {
                 const double rx = x + s.offset_x, ry = y + s.offset_y;
@@ -86,8 +91,8 @@ Test(field_rays, the_rows_are_the_passing_pixels_with_their_exact_rays)
                           next - 1, row->raster_x, row->raster_y, k, x, y, rx, ry);
                 cr_assert(row->film_x == fp.x && row->film_y == fp.y, "row %zu: film point", next - 1);
                 cr_assert(same_vec(row->o, r.o) && same_vec(row->d, r.d), "row %zu: ray", next - 1);
-                cr_assert(row->weight == weight, "row %zu: weight %.17g, expected %.17g", next - 1, row->weight,
-                          weight);
+                cr_assert(row->weight == weight * scale, "row %zu: weight %.17g, expected %.17g", next - 1,
+                          row->weight, weight * scale);
             }
     }
     cr_expect_eq(next, n, "%zu rows beyond the passing pixels", n - next);

@@ -10,6 +10,7 @@
 #include <string.h>
 #include "field/fieldmap.h"
 #include "field/fieldrays.h"
+#include "field/strata.h"
 #include "field/subimage.h"
 #include "raytable/chunk_ini.h"
 #include "optics/pupil.h"
@@ -29,6 +30,7 @@ typedef struct job {
     const outfile *map;        /* the field map, its weights written as sub-images are built */
     const samplemap_header *header;
     const field_tolerance *tol;
+    field_strata strata;
     sub *subs;
     int spp;
     atomic_int next;
@@ -59,8 +61,10 @@ static void *build_worker(void *arg)
         l2p_error e;
         s->weights = malloc(pixels * sizeof *s->weights);
         const film_sample shared = field_shared_sample(j->c, k, &s->band);
-        int st = s->weights ? field_build_subimage(j->c, shared, j->tol, FIELD_COARSEST_CELL, &s->mesh,
-                                                   s->weights, &s->stats, &e)
+        int st = s->weights ? field_build_subimage(j->c, shared,
+                                                   field_strata_scale(&j->strata, j->c, shared), j->tol,
+                                                   FIELD_COARSEST_CELL, &s->mesh, s->weights,
+                                                   &s->stats, &e)
                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
         if (!st && !(s->stats.worst_pixels <= j->tol->pixels))
             st = l2p_fail(&e, L2P_BAD_INPUT, NULL, 0,
@@ -443,6 +447,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     if (!st)
         st = field_map_begin(&out->map, &header, err);
     job j = {.c = c, .map = &out->map, .header = &header, .tol = &tol, .subs = subs, .spp = spp};
+    field_strata_count(c, &j.strata);
     atomic_init(&j.next, 0);
     atomic_init(&j.status, L2P_OK);
     pthread_mutex_init(&j.lock, NULL);

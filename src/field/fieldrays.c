@@ -5,6 +5,7 @@
 #include "field/fieldrays.h"
 
 #include <stdlib.h>
+#include "field/strata.h"
 #include "field/subimage.h"
 
 static void put_row(FILE *out, const camera *c, film_sample s, long i, const sample_batch *b, int k,
@@ -23,13 +24,14 @@ static void put_row(FILE *out, const camera *c, film_sample s, long i, const sam
 }
 
 /* Sub-image k's rows. */
-static void put_subimage(FILE *out, const camera *c, uint32_t k, const field_placement *at,
-                         sample_batch *b)
+static void put_subimage(FILE *out, const camera *c, const field_strata *t, uint32_t k,
+                         const field_placement *at, sample_batch *b)
 {
     const film_sample s = field_shared_sample(c, (int)k, NULL);
+    const double scale = field_strata_scale(t, c, s);
     const long n = (long)(c->crop_x1 - c->crop_x0) * (c->crop_y1 - c->crop_y0);
     for (long start = 0; start < n && !ferror(out); start += CAMERA_BATCH) {
-        field_trace_pixels(c, s, start, (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH), b);
+        field_trace_pixels(c, s, scale, start, (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH), b);
         for (int j = 0; j < b->n; j++)
             if (b->passed[j])
                 put_row(out, c, s, start + j, b, j, at);
@@ -46,8 +48,10 @@ int field_rays_write(FILE *out, const char *path, const camera *c, const field_p
                           "dir_z,weight,wavelength_nm,image,image_x,image_y\n"
                         : "raster_x,raster_y,film_x,film_y,origin_x,origin_y,origin_z,dir_x,dir_y,"
                           "dir_z,weight,image,image_x,image_y\n", out);
+    field_strata t;
+    field_strata_count(c, &t);
     for (int k = 0; k < spp && !ferror(out); k++)
-        put_subimage(out, c, (uint32_t)k, &at[k], b);
+        put_subimage(out, c, &t, (uint32_t)k, &at[k], b);
     free(b);
     return ferror(out) ? l2p_fail(err, L2P_FAILED, path, 0, "write failed") : L2P_OK;
 }

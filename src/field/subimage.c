@@ -71,7 +71,8 @@ film_sample field_shared_sample(const camera *c, int k, uint32_t *band)
     return s;
 }
 
-void field_trace_pixels(const camera *c, film_sample s, long first, int n, sample_batch *batch)
+void field_trace_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
+                        sample_batch *batch)
 {
     batch->n = n;
     for (int k = 0; k < n; k++) {
@@ -88,10 +89,11 @@ void field_trace_pixels(const camera *c, film_sample s, long first, int n, sampl
         /* as with pixel sampling, a film point beyond the lens's reach is no sample */
         batch->passed[k] = batch->passed[k] && pupil_reaches(&c->pupil, batch->film_point[k]) &&
                            v3_isfinite(r->o) && v3_isfinite(r->d) && isfinite(batch->weight[k]);
+        batch->weight[k] *= weight_scale;
     }
 }
 
-static void trace_all(builder *b, film_sample s)
+static void trace_all(builder *b, film_sample s, double weight_scale)
 {
     const camera *c = b->c;
     sample_batch *batch = malloc(sizeof *batch);
@@ -102,7 +104,8 @@ static void trace_all(builder *b, film_sample s)
     const double front = c->lens.surface[0].vertex_z_mm;
     const long n = (long)b->w * b->h;
     for (long start = 0; start < n; start += CAMERA_BATCH) {
-        field_trace_pixels(c, s, start, (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH), batch);
+        field_trace_pixels(c, s, weight_scale, start,
+                           (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH), batch);
         for (int k = 0; k < batch->n; k++) {
             ray r = batch->out[k];
             const long i = start + k;
@@ -552,8 +555,9 @@ static void build_grid(builder *b, int base)
                 lone_face(b, x, y);
 }
 
-int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
-                         field_mesh *out, float *weights, field_stats *st, l2p_error *err)
+int field_build_subimage(const camera *c, film_sample s, double weight_scale,
+                         const field_tolerance *t, int base_cell, field_mesh *out, float *weights,
+                         field_stats *st, l2p_error *err)
 {
     builder b = {.c = c, .tol = t, .per_sin2 = 1.0 / (sin(t->angle_rad) * sin(t->angle_rad)),
                  .per_origin2 = 1.0 / (t->origin_mm * t->origin_mm),
@@ -571,7 +575,7 @@ int field_build_subimage(const camera *c, film_sample s, const field_tolerance *
     b.oom = !b.rays || !b.passed || !b.covered || !b.sum || !b.vid || !b.stricter;
     if (!b.oom) {
         memset(b.vid, 0xff, n * sizeof *b.vid);
-        trace_all(&b, s);
+        trace_all(&b, s, weight_scale);
         pixel_scale(&b);
     }
     if (!b.oom)

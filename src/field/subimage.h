@@ -50,21 +50,24 @@ enum { FIELD_COARSEST_CELL = 128, FIELD_BASE_CELL = 32 };
    gives it a ray within the tolerance (checked here, with the model of povuv.c), and no face
    contains a pixel the lens blocks (or whose film point is beyond the lens's reach, as with
    pixel sampling). out is cleared first; its render size is field_render_size of the crop's.
-   weights (NULL, or one a crop pixel, row by row) gets each pixel's sample weight, 0 where
-   blocked. Returns L2P_OK, or L2P_FAILED when out of memory. */
-int field_build_subimage(const camera *c, film_sample s, const field_tolerance *t, int base_cell,
-                         field_mesh *out, float *weights, field_stats *st, l2p_error *err);
+   weights (NULL, or one a crop pixel, row by row) gets each pixel's sample weight times
+   weight_scale (field_strata_scale), 0 where blocked. Returns L2P_OK, or L2P_FAILED when out
+   of memory. */
+int field_build_subimage(const camera *c, film_sample s, double weight_scale,
+                         const field_tolerance *t, int base_cell, field_mesh *out, float *weights,
+                         field_stats *st, l2p_error *err);
 
 /* Pixel i of the crop (row by row: i = y * crop width + x) seen with shared sample s: its
    raster position, (crop_x0 + x + offset_x, crop_y0 + y + offset_y). */
 void field_pixel_raster(const camera *c, film_sample s, long i, double *rx, double *ry);
 
 /* The exact rays of crop pixels first .. first + n - 1 (n <= CAMERA_BATCH) seen with shared
-   sample s, into b: each one's film point, ray (camera space), weight, and whether it is
-   rendered: the lens passes it, its film point is within the lens's reach (as pixel sampling
-   asks) and the ray and weight are finite. Building a sub-image and the --rays CSV both take
+   sample s, into b: each one's film point, ray (camera space), weight (times weight_scale,
+   field_strata_scale), and whether it is rendered: the lens passes it, its film point is
+   within the lens's reach (as pixel sampling asks) and the ray and weight are finite. Building a sub-image and the --rays CSV both take
    the rays from here, so that they are the same rays. */
-void field_trace_pixels(const camera *c, film_sample s, long first, int n, sample_batch *b);
+void field_trace_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
+                        sample_batch *b);
 
 /* Sub-image k's shared sample: point k of the Owen-scrambled Sobol set; with dispersion also
    its wavelength, the bands dealt to the sub-images as pixel sampling deals them to a pixel's

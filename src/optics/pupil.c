@@ -101,6 +101,13 @@ static inline void disk_point(double u, double v, double *x, double *y)
     *y = r * sin(phi);
 }
 
+bool pupil_in_margin(const pupil *pu, double u, double v)
+{
+    /* the concentric map sends the square's ring max(|a|, |b|) > r onto the disk's |d| > r */
+    return pupil_is_fitted(pu) &&
+           fmax(fabs(2.0 * u - 1.0), fabs(2.0 * v - 1.0)) > 1.0 / PUPIL_FIT_MARGIN;
+}
+
 vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 {
     /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */
@@ -137,7 +144,7 @@ double pupil_shape_radius_mm(const pupil_shape *e, double cos_phi)
 
 bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out)
 {
-    if (!(pu->node_spacing_mm > 0.0)) {
+    if (!pupil_is_fitted(pu)) {
         if (!(r_mm <= pu->reach_mm))
             return false;
         out->centre_mm = 0.0;
@@ -165,7 +172,7 @@ static bool locate(const pupil *pu, vec3 p, double *cx, double *cy, double *c, d
     const double r = sqrt(p.x * p.x + p.y * p.y);
     *c = r > 0.0 ? p.x / r : 1.0;
     *s = r > 0.0 ? p.y / r : 0.0;
-    if (!(pu->node_spacing_mm > 0.0)) {
+    if (!pupil_is_fitted(pu)) {
         *j = -1;
         *cx = *cy = 0.0;
         return r <= pu->reach_mm;

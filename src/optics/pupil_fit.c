@@ -24,8 +24,8 @@ enum {
    bulge past the radius interpolated linearly in the angle: by about s^2 / 8 times the
    radius's second derivative in the angle, s = pi / 96, a few 1e-4 of the radius for the
    regions a lens makes. 0.4% holds that several times over, and the fit samples four angles
-   between each two directions as well. */
-static const double MARGIN = 1.004;
+   between each two directions as well (PUPIL_FIT_MARGIN, pupil.h). */
+static const double MARGIN = PUPIL_FIT_MARGIN;
 
 typedef struct region {
     bool found;
@@ -385,7 +385,7 @@ static void extend_reach(pupil *pu, const lens *l)
 
 void pupil_cover(pupil *pu, const lens *l)
 {
-    if (!(pu->node_spacing_mm > 0.0))
+    if (!pupil_is_fitted(pu))
         return;
     extend_reach(pu, l);
     for (int j = 0; j <= PUPIL_NODES; j++)
