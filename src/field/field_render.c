@@ -62,7 +62,7 @@ static void *build_worker(void *arg)
         s->weights = malloc(pixels * sizeof *s->weights);
         const film_sample shared = field_shared_sample(j->c, k, &s->band);
         int st = s->weights ? field_build_subimage(j->c, shared,
-                                                   field_strata_scale(&j->strata, j->c, shared), j->tol,
+                                                   field_strata_scale(&j->strata, shared), j->tol,
                                                    FIELD_COARSEST_CELL, &s->mesh, s->weights,
                                                    &s->stats, &e)
                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");

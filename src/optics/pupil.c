@@ -101,13 +101,6 @@ static inline void disk_point(double u, double v, double *x, double *y)
     *y = r * sin(phi);
 }
 
-bool pupil_in_margin(const pupil *pu, double u, double v)
-{
-    /* the concentric map sends the square's ring max(|a|, |b|) > r onto the disk's |d| > r */
-    return pupil_is_fitted(pu) &&
-           fmax(fabs(2.0 * u - 1.0), fabs(2.0 * v - 1.0)) > 1.0 / PUPIL_FIT_MARGIN;
-}
-
 vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 {
     /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */

@@ -66,17 +66,18 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err);
    divides by the sampling density. */
 void pupil_fit(pupil *pu, const lens *l, double film_radius_mm);
 
-/* The growth every fitted shape gets last (pupil_fit.c says why). Samples whose point of the
-   unit disk lies beyond 1 / PUPIL_FIT_MARGIN, a ring of 1 - 1 / PUPIL_FIT_MARGIN^2 of its area,
-   fall in that margin: on the axis, where the region is a disk, the lens passes none of them. */
+/* The growth every fitted shape gets last (pupil_fit.c says why). */
 #define PUPIL_FIT_MARGIN 1.004
 
-/* Whether pu was fitted (pupil_fit), and so has the margin. */
+/* Whether pu was fitted (pupil_fit). */
 static inline bool pupil_is_fitted(const pupil *pu) { return pu->node_spacing_mm > 0.0; }
 
-/* Whether sample (u, v) falls in the margin of fitted pupil pu; false for a pupil that was not
-   fitted, which has none. */
-bool pupil_in_margin(const pupil *pu, double u, double v);
+/* The radius of sample (u, v)'s point on the unit disk (the concentric map sends the square's
+   ring max(|2u - 1|, |2v - 1|) = r onto the circle of radius r). */
+static inline double pupil_disk_radius(double u, double v)
+{
+    return fmax(fabs(2.0 * u - 1.0), fabs(2.0 * v - 1.0));
+}
 
 /* Grows a fitted pupil so that it also holds every ray that lens l passes: l is the same lens
    at another wavelength (lens_at_wavelength), whose passing regions are those of the fit
