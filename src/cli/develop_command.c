@@ -4,12 +4,29 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "base/outfile.h"
 #include "field/field_develop.h"
 #include "image/develop.h"
 #include "image/samplemap.h"
 #include "raytable/chunk_name.h"
 #include "raytable/povmesh.h"
+
+static bool exists(const char *path)
+{
+    struct stat sb;
+    return stat(path, &sb) == 0;
+}
+
+/* The render of a table of one chunk: PREFIX.exr, or PREFIX.c000.exr when the trace was asked
+   for chunks (--memory-mb) and one was enough; its .ini says which. */
+static char *single_render_name(const char *prefix)
+{
+    char *ini = povmesh_chunk_file(prefix, false, 0, "ini");
+    const bool chunked = ini && !exists(ini);
+    free(ini);
+    return povmesh_chunk_file(prefix, chunked, 0, "exr");
+}
 
 /* The renders of the chunks: as given, or by the names the chunks' .ini files give POV-Ray
    (PREFIX.exr, or PREFIX.c000.exr, PREFIX.c001.exr, ...). */
@@ -25,7 +42,7 @@ static char **render_names(const cli *c, long long chunks, l2p_error *err)
     char **names = calloc((size_t)chunks, sizeof *names);
     for (long long k = 0; names && k < chunks; k++) {
         names[k] = given        ? strdup(c->positional[k + 1])
-                   : chunks == 1 ? povmesh_chunk_file(prefix, false, 0, "exr")
+                   : chunks == 1 ? single_render_name(prefix)
                                  : chunk_file_name(prefix, (int)k, "exr");
         if (!names[k])
             break;
@@ -33,13 +50,32 @@ static char **render_names(const cli *c, long long chunks, l2p_error *err)
     return names;
 }
 
-/* The picture must not replace the map or a render it is developed from. */
+/* A render older than its map was made from an earlier trace of the same prefix, whose map the
+   new one replaced: developing mixes the two. Said, not refused: a copy (cp without -p) can
+   reorder the times of files that belong together. */
+static void warn_older(const char *map_path, char *const *renders, long long count)
+{
+    struct stat map, r;
+    if (stat(map_path, &map) != 0)
+        return;
+    for (long long k = 0; k < count; k++)
+        if (renders[k] && stat(renders[k], &r) == 0 &&
+            (r.st_mtim.tv_sec < map.st_mtim.tv_sec ||
+             (r.st_mtim.tv_sec == map.st_mtim.tv_sec && r.st_mtim.tv_nsec < map.st_mtim.tv_nsec)))
+            fprintf(stderr, "lens2pov: warning: %s is older than %s: was it rendered from an earlier "
+                    "trace? (render the trace's .ini again)\n", renders[k], map_path);
+}
+
+/* The picture must not replace the map or a render it is developed from; a render older than
+   the map is warned of. */
 static int check_inputs(const cli *c, const char *map_path, char *const *renders, long long count,
                         l2p_error *err)
 {
     int st = outfile_check_not_input(c->output, map_path, "the sample map", err);
     for (long long k = 0; !st && k < count; k++)
         st = outfile_check_not_input(c->output, renders[k], "a render to develop", err);
+    if (!st)
+        warn_older(map_path, renders, count);
     return st;
 }
 

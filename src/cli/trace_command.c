@@ -8,6 +8,7 @@
 #include "base/outfile.h"
 #include "cli/framing.h"
 #include "cli/sizecheck.h"
+#include "cli/traceset.h"
 #include "field/field_render.h"
 #include "raytable/chunk_ini.h"
 #include "raytable/povmesh.h"
@@ -34,6 +35,15 @@ static int check_trace_outputs(const cli *c, l2p_error *err)
     return st;
 }
 
+/* After a trace, what an earlier trace of the prefix left that this one did not write. */
+static void remove_stale(const cli *c, trace_layout layout, int count)
+{
+    const int removed = trace_set_remove_stale(c->output, layout, count);
+    if (removed && !c->quiet)
+        fprintf(stderr, "lens2pov: removed %d include%s and ini%s of an earlier trace of %s\n",
+                removed, removed == 1 ? "" : "s", removed == 1 ? "" : "s", c->output);
+}
+
 /* --sampling field: the field map and each render's include and ini (docs/fields.md). */
 static int trace_field(const cli *c, const camera *cam, l2p_error *err)
 {
@@ -47,6 +57,8 @@ static int trace_field(const cli *c, const camera *cam, l2p_error *err)
     if (!st && c->rays_csv)
         st = outfile_commit(&csv, err);
     outfile_discard(&csv);
+    if (!st)
+        remove_stale(c, TRACE_LAYOUT_FIELD, stats.renders);
     if (!st && !c->quiet)
         fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%): %d sub-images, "
                 "%lld faces in %d renders\n", stats.passed, stats.pixels,
@@ -79,6 +91,8 @@ int trace_command(const cli *given, l2p_error *err)
     const long long chunk_faces = c->memory_mb > 0 ? raytable_faces_for_memory(c->memory_mb) : 0;
     const raytable_request q = {c->output, c->rays_csv, chunk_faces, !c->quiet, NULL, NULL};
     st = raytable_write(&cam, &q, &stats, err);
+    if (!st)
+        remove_stale(c, chunk_faces > 0 ? TRACE_LAYOUT_CHUNKS : TRACE_LAYOUT_ONE, stats.chunks);
     if (!st && !c->quiet)
         fprintf(stderr, "lens2pov: %lld of %lld rays pass the lens (%.1f%%), %.2f s\n",
                 stats.passed, stats.samples,

@@ -162,7 +162,8 @@ int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, c
 {
     /* as the pixel table's include (docs/povray.md, "Output and gamma"): raise the language
        version to 3.7 only when it is lower, and put it back */
-    fprintf(out, "#if (version < 3.7)\n  #declare Lens2pov_Version = version;\n  #version 3.7;\n#end\n");
+    fprintf(out, "// lens2pov ray field: sub-images of rays for mesh_camera (distribution 3, smooth).\n"
+                 "#if (version < 3.7)\n  #declare Lens2pov_Version = version;\n  #version 3.7;\n#end\n");
     if (m->faces == 0) {
         /* A render none of whose pixels the lens passes (POV-Ray refuses a mesh without
            vertices): one face of zero area, in space and in UV, with equal normals. POV-Ray

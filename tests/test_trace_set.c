@@ -1,0 +1,117 @@
+/* A trace's files for its prefix as a set: develop finds the renders by the names the trace
+   gave them, a new trace of the prefix removes the includes and inis an earlier one left, and
+   develop warns of a render older than its map. End to end, with POV-Ray for the renders. */
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "image/image_io.h"
+#include "support.h"
+
+#define DGAUSS LENS_DIR "dgauss.50mm.dat"
+
+/* Traces DGAUSS at 24x18 with 2 spp into PREFIX, with the extra options given (at most three,
+   NULL-ended). */
+static void trace(const char *prefix, const char *a, const char *b, const char *c)
+{
+    char *errtext = NULL;
+    const int st = run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "24", "--height", "18",
+                                "--spp", "2", "--quiet", "-o", prefix, a, b, c, (char *)NULL);
+    cr_assert_eq(st, 0, "trace: %s", errtext ? errtext : "");
+    free(errtext);
+}
+
+/* Renders ini through POV-Ray with a plain background, the include beside it. */
+static void render(const char *dir, const char *ini, const char *inc)
+{
+    char wrapper[1024], cmd[4096];
+    snprintf(wrapper, sizeof wrapper, "%s/wrapper.pov", dir);
+    FILE *f = fopen(wrapper, "w");
+    cr_assert_not_null(f);
+    fprintf(f, "background { rgb <0.2, 0.5, 0.9> }\n#include \"%s\"\n", inc);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "povray '%s' +I'%s' -V -GA >/dev/null 2>&1", ini, wrapper);
+    cr_assert_eq(system_povray(cmd), 0, "POV-Ray on %s", ini);
+}
+
+/* A trace asked for chunks (--memory-mb) that needs only one names it PREFIX.c000: develop
+   finds its render by that name (it looked for PREFIX.exr and failed), and the picture is the
+   one developed from the render named outright. */
+Test(trace_set, one_chunk_asked_for_is_developed_by_its_own_name)
+{
+    const char *dir = test_tmpdir();
+    char prefix[1024];   /* tmp_path's buffers rotate */
+    snprintf(prefix, sizeof prefix, "%s/p", dir);
+    trace(prefix, "--memory-mb", "1024", NULL);
+    cr_assert(file_exists(tmp_path(dir, "p.c000.ini")) && !file_exists(tmp_path(dir, "p.c001.ini")),
+              "the trace is not one chunk of the chunked layout");
+    render(dir, tmp_path(dir, "p.c000.ini"), tmp_path(dir, "p.c000.inc"));
+    char *errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "a.exr"), (char *)NULL),
+                 0, "develop: %s", errtext ? errtext : "");
+    free(errtext);
+    run_lens2pov_ok("develop, the render named", "develop", prefix, tmp_path(dir, "p.c000.exr"), "-o",
+                    tmp_path(dir, "b.exr"), (char *)NULL);
+    int w, h, w2, h2;
+    float *a, *b;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "a.exr"), &w, &h, &a, &err), 0, "%s", err.text);
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "b.exr"), &w2, &h2, &b, &err), 0, "%s", err.text);
+    cr_assert(w == 24 && h == 18 && w2 == w && h2 == h);
+    cr_assert(memcmp(a, b, sizeof *a * 4 * 24 * 18) == 0, "the two pictures differ");
+    free(a), free(b);
+}
+
+/* Sampling pixel in chunks, then field, then pixel in one table: each trace leaves only its own
+   includes and inis (and the map), whatever the earlier ones wrote; files of the same names that
+   lens2pov did not write are kept. */
+Test(trace_set, a_trace_removes_what_an_earlier_trace_of_the_prefix_left)
+{
+    const char *dir = test_tmpdir();
+    char prefix[1024];   /* tmp_path's buffers rotate */
+    snprintf(prefix, sizeof prefix, "%s/p", dir);
+    char listing[4096];
+    trace(prefix, "--memory-mb", "0.05", NULL);
+    const int chunks = count_entries(dir, "p.c", listing, sizeof listing) / 2;
+    cr_assert_gt(chunks, 2, "%s", listing);
+    write_text(tmp_path(dir, "p.c999.inc"), "// the user's own\n");
+    write_text(tmp_path(dir, "p.f007.ini"), "; the user's own\n");
+    trace(prefix, "--sampling", "field", NULL);
+    cr_expect_eq(count_entries(dir, "p.c", listing, sizeof listing), 1, "%s", listing);
+    cr_expect(file_exists(tmp_path(dir, "p.c999.inc")));
+    cr_expect(file_exists(tmp_path(dir, "p.f000.inc")) && file_exists(tmp_path(dir, "p.f000.ini")));
+    cr_expect(file_exists(tmp_path(dir, "p.f007.ini")), "the user's file");
+    trace(prefix, NULL, NULL, NULL);
+    cr_expect_eq(count_entries(dir, "p.f", listing, sizeof listing), 1, "%s", listing);
+    cr_expect(file_exists(tmp_path(dir, "p.inc")) && file_exists(tmp_path(dir, "p.ini")) &&
+              file_exists(tmp_path(dir, "p.map")));
+    trace(prefix, "--memory-mb", "0.05", NULL);   /* the one table's files go in turn */
+    cr_expect_not(file_exists(tmp_path(dir, "p.inc")));
+    cr_expect_not(file_exists(tmp_path(dir, "p.ini")));
+    cr_expect_eq(count_entries(dir, "p.c", listing, sizeof listing), 2 * chunks + 1, "%s", listing);
+}
+
+/* A render from an earlier trace of the prefix, developed with the new map: a warning that names
+   it; none for a render made after its trace. */
+Test(trace_set, develop_warns_of_a_render_older_than_its_map)
+{
+    const char *dir = test_tmpdir();
+    char prefix[1024];   /* tmp_path's buffers rotate */
+    snprintf(prefix, sizeof prefix, "%s/p", dir);
+    trace(prefix, NULL, NULL, NULL);
+    render(dir, tmp_path(dir, "p.ini"), tmp_path(dir, "p.inc"));
+    char *errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "a.png"), (char *)NULL),
+                 0);
+    cr_expect(!errtext || !strstr(errtext, "older than"), "%s", errtext);
+    free(errtext);
+    usleep(20000);   /* a later time on any file system that keeps hundredths */
+    trace(prefix, "--seed", "2", NULL);
+    errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "b.png"), (char *)NULL),
+                 0);
+    cr_expect(errtext && strstr(errtext, "p.exr is older than") && strstr(errtext, "p.map"), "%s",
+              errtext ? errtext : "(nothing on stderr)");
+    free(errtext);
+}
