@@ -115,3 +115,17 @@ Test(trace_set, develop_warns_of_a_render_older_than_its_map)
               errtext ? errtext : "(nothing on stderr)");
     free(errtext);
 }
+
+/* With no .ini beside the map (moved away after rendering), the render that is there decides:
+   PREFIX.exr for a table of one chunk traced without --memory-mb. */
+Test(trace_set, a_one_table_render_is_found_without_its_ini)
+{
+    const char *dir = test_tmpdir();
+    char prefix[1024];   /* tmp_path's buffers rotate */
+    snprintf(prefix, sizeof prefix, "%s/p", dir);
+    trace(prefix, NULL, NULL, NULL);
+    render(dir, tmp_path(dir, "p.ini"), tmp_path(dir, "p.inc"));
+    cr_assert_eq(unlink(tmp_path(dir, "p.ini")), 0);
+    run_lens2pov_ok("develop without the ini", "develop", prefix, "-o", tmp_path(dir, "a.png"), (char *)NULL);
+    cr_expect(file_exists(tmp_path(dir, "a.png")));
+}

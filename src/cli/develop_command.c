@@ -18,13 +18,21 @@ static bool exists(const char *path)
     return stat(path, &sb) == 0;
 }
 
+/* Whether PREFIX.c000.EXT is there and PREFIX.EXT is not. */
+static bool only_chunked(const char *prefix, const char *ext)
+{
+    char *one = povmesh_chunk_file(prefix, false, 0, ext), *chunk = chunk_file_name(prefix, 0, ext);
+    const bool only = one && chunk && !exists(one) && exists(chunk);
+    free(one), free(chunk);
+    return only;
+}
+
 /* The render of a table of one chunk: PREFIX.exr, or PREFIX.c000.exr when the trace was asked
-   for chunks (--memory-mb) and one was enough; its .ini says which. */
+   for chunks (--memory-mb) and one was enough; the .ini beside the map says which, else the
+   render that is there. */
 static char *single_render_name(const char *prefix)
 {
-    char *ini = povmesh_chunk_file(prefix, false, 0, "ini");
-    const bool chunked = ini && !exists(ini);
-    free(ini);
+    const bool chunked = only_chunked(prefix, "ini") || only_chunked(prefix, "exr");
     return povmesh_chunk_file(prefix, chunked, 0, "exr");
 }
 
