@@ -35,6 +35,15 @@ static void render(const char *dir, const char *ini, const char *inc)
     cr_assert_eq(system_povray(cmd), 0, "POV-Ray on %s", ini);
 }
 
+/* PREFIX = DIR/p (tmp_path's buffers rotate, so it gets its own) traced as one table and
+   rendered through POV-Ray. */
+static void trace_and_render(const char *dir, char *prefix, size_t size)
+{
+    snprintf(prefix, size, "%s/p", dir);
+    trace(prefix, NULL, NULL, NULL);
+    render(dir, tmp_path(dir, "p.ini"), tmp_path(dir, "p.inc"));
+}
+
 /* A trace asked for chunks (--memory-mb) that needs only one names it PREFIX.c000: develop
    finds its render by that name (it looked for PREFIX.exr and failed), and the picture is the
    one developed from the render named outright. */
@@ -97,10 +106,8 @@ Test(trace_set, a_trace_removes_what_an_earlier_trace_of_the_prefix_left)
 Test(trace_set, develop_warns_of_a_render_older_than_its_map)
 {
     const char *dir = test_tmpdir();
-    char prefix[1024];   /* tmp_path's buffers rotate */
-    snprintf(prefix, sizeof prefix, "%s/p", dir);
-    trace(prefix, NULL, NULL, NULL);
-    render(dir, tmp_path(dir, "p.ini"), tmp_path(dir, "p.inc"));
+    char prefix[1024];
+    trace_and_render(dir, prefix, sizeof prefix);
     char *errtext = NULL;
     cr_assert_eq(run_lens2pov(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "a.png"), (char *)NULL),
                  0);
@@ -121,10 +128,8 @@ Test(trace_set, develop_warns_of_a_render_older_than_its_map)
 Test(trace_set, a_one_table_render_is_found_without_its_ini)
 {
     const char *dir = test_tmpdir();
-    char prefix[1024];   /* tmp_path's buffers rotate */
-    snprintf(prefix, sizeof prefix, "%s/p", dir);
-    trace(prefix, NULL, NULL, NULL);
-    render(dir, tmp_path(dir, "p.ini"), tmp_path(dir, "p.inc"));
+    char prefix[1024];
+    trace_and_render(dir, prefix, sizeof prefix);
     cr_assert_eq(unlink(tmp_path(dir, "p.ini")), 0);
     run_lens2pov_ok("develop without the ini", "develop", prefix, "-o", tmp_path(dir, "a.png"), (char *)NULL);
     cr_expect(file_exists(tmp_path(dir, "a.png")));

@@ -40,9 +40,9 @@ static double core_radius_at(const camera *c, double nm, sample_batch *b)
 {
     if (!axis_passes(c, 0.0, nm, b))
         return 0.0;
-    double in = 0.0, out = 1.0;
     if (axis_passes(c, 1.0, nm, b))
         return 1.0;
+    double in = 0.0, out = 1.0;
     for (int i = 0; i < 40; i++) {
         const double mid = 0.5 * (in + out);
         *(axis_passes(c, mid, nm, b) ? &in : &out) = mid;
@@ -74,10 +74,11 @@ void field_strata_count(const camera *c, field_strata *out)
         free(b);
         return;
     }
+    /* without dispersion every sample is traced at the d line: one radius serves */
+    const double d_line = c->dispersion ? 0.0 : core_radius_at(c, 0.0, b);
     bool usable = true;
     for (int i = 0; i < FIELD_STRATA_WAVELENGTHS; i++) {
-        out->core_radius[i] = c->dispersion ? core_radius_at(c, strata_nm(i), b) : i ? out->core_radius[0]
-                                                                              : core_radius_at(c, 0.0, b);
+        out->core_radius[i] = c->dispersion ? core_radius_at(c, strata_nm(i), b) : d_line;
         usable = usable && out->core_radius[i] > 0.0;
     }
     free(b);
