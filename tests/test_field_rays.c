@@ -72,8 +72,8 @@ Test(field_rays, the_rows_are_the_passing_pixels_with_their_exact_rays)
     field_strata_count(&c, &t);
     size_t next = 0, blocked = 0;
     for (uint32_t k = 0; k < SPP; k++) {
-        const film_sample s = sobol_shared_sample(SEED, k);
-        const double scale = field_strata_scale(&t, s);   /* the sub-image's stratum */
+        film_sample s = sobol_shared_sample(SEED, k);
+        const double scale = field_strata_place(&t, &s);   /* the sub-image's stratum */
         for (int y = CROP_Y0; y < CROP_Y1; y++)
             for (int x = CROP_X0; x < CROP_X1; x++) {
                 const double rx = x + s.offset_x, ry = y + s.offset_y;

@@ -98,6 +98,35 @@ Test(pupil, the_weight_divides_by_the_exact_density)
     }
 }
 
+/* The concentric map's inverse (field sampling places its own disk points): on the axis the
+   hand-made region is the disk of 5 mm about it, so the sample pupil_square_of_disk gives for
+   disk point (x, y) must land on (5 x, 5 y). Random points, and the centre, the axes and the
+   diagonals, where the map changes branch. */
+Test(pupil, the_inverse_concentric_map_returns_the_disk_point)
+{
+    const pupil pu = hand_made(40.0);
+    const double h = sqrt(0.5);
+    const double fixed[][2] = {{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}, {h, h}, {-h, h}, {h, -h},
+                               {-h, -h}, {0.3, 0.3}, {1e-300, 0}, {0, -1e-300}};
+    uint64_t state = 7;
+    for (int n = 0; n < 10000; n++) {
+        double x, y;
+        if (n < 12) {
+            x = fixed[n][0], y = fixed[n][1];
+        } else {
+            const double r = sqrt(unit(&state)), t = 2.0 * M_PI * unit(&state);
+            x = r * cos(t), y = r * sin(t);
+        }
+        double u, v, px, py;
+        pupil_square_of_disk(x, y, &u, &v);
+        cr_assert(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0, "(%g, %g): (%g, %g)", x, y, u, v);
+        cr_assert_float_eq(pupil_disk_radius(u, v), hypot(x, y), 1e-15);
+        sample_point(&pu, v3(0.0, 0.0, 0.0), u, v, &px, &py);
+        cr_assert(fabs(px - 5.0 * x) < 1e-13 && fabs(py - 5.0 * y) < 1e-13,
+                  "(%.17g, %.17g) lands on (%.17g, %.17g)", x, y, px / 5.0, py / 5.0);
+    }
+}
+
 /* A fixed sample moves continuously as the film point crosses the nodes and the axis: the
    next pupil field (one sample over the whole film) must have no seams. */
 Test(pupil, a_sample_moves_continuously_with_the_film_point)

@@ -60,9 +60,9 @@ static void *build_worker(void *arg)
         sub *s = &j->subs[k];
         l2p_error e;
         s->weights = malloc(pixels * sizeof *s->weights);
-        const film_sample shared = field_shared_sample(j->c, k, &s->band);
-        int st = s->weights ? field_build_subimage(j->c, shared,
-                                                   field_strata_scale(&j->strata, shared), j->tol,
+        film_sample shared = field_shared_sample(j->c, k, &s->band);
+        const double scale = field_strata_place(&j->strata, &shared);
+        int st = s->weights ? field_build_subimage(j->c, shared, scale, j->tol,
                                                    FIELD_COARSEST_CELL, &s->mesh, s->weights,
                                                    &s->stats, &e)
                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");

@@ -27,8 +27,8 @@ static void put_row(FILE *out, const camera *c, film_sample s, long i, const sam
 static void put_subimage(FILE *out, const camera *c, const field_strata *t, uint32_t k,
                          const field_placement *at, sample_batch *b)
 {
-    const film_sample s = field_shared_sample(c, (int)k, NULL);
-    const double scale = field_strata_scale(t, s);
+    film_sample s = field_shared_sample(c, (int)k, NULL);
+    const double scale = field_strata_place(t, &s);
     const long n = (long)(c->crop_x1 - c->crop_x0) * (c->crop_y1 - c->crop_y0);
     for (long start = 0; start < n && !ferror(out); start += CAMERA_BATCH) {
         field_trace_pixels(c, s, scale, start, (int)(n - start < CAMERA_BATCH ? n - start : CAMERA_BATCH), b);

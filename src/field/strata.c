@@ -1,16 +1,22 @@
 /* Every pixel of a field render sees the same N shared pupil points. On the axis the passing
    region is a disk, but the stop-image pupil samples a larger one: the fit's last growth
-   (PUPIL_FIT_MARGIN) and, with dispersion, the growth that holds every wavelength's region. So
-   the M points beyond the passing disk are blocked at every pixel near the axis at once, and
-   the plain estimate (1 / N) sum f there is (N - M) / (N s) times the truth, s the disk's share
-   of the pupil: the whole picture a few percent too bright or too dark, by seed.
+   (PUPIL_FIT_MARGIN) and, with dispersion, the growth that holds every wavelength's region. A
+   point beyond the passing disk is blocked at every pixel near the axis at once, so with the
+   plain estimate (1 / N) sum f the whole picture came out (N - M) / (N s) of the truth, M the
+   points the seed put there and s the disk's share of the pupil: a few percent off, by seed.
 
-   Post-stratified over the core, the disk that passes on the axis (radius c(lambda) on the
-   unit disk, measured here), and the ring around it (Owen, "Monte Carlo theory, methods and
-   examples", 2013, section 8.4), the estimate is s mean_core f + (1 - s) mean_ring f: a core
-   sample is weighted by N s / (N - M), a ring sample by N (1 - s) / M, and the axis is exposed
-   right for every seed. With M = 0 the ring's light is left out: none on the axis, a little off
-   it (docs/fields.md measures it). */
+   So the shared points are stratified (Owen, "Monte Carlo theory, methods and examples", 2013,
+   section 8.4) over the core, the disk that passes on the axis (radius c(lambda) on
+   the unit disk, measured here), and the ring around it. The stratum comes from pupil_u alone:
+   a shared sample with pupil_u >= 1 - q goes to the ring. In the first P = 2^m samples each
+   interval of width 2^-m holds one pupil_u (sobol.h), so with q = k / P exactly k of them go to
+   the ring, whatever the seed. A sample is then placed uniformly in its stratum by the equal-area
+   polar map, r^2 = c^2 u / (1 - q) in the core and c^2 + (1 - c^2) (u - 1 + q) / q in the ring,
+   phi = 2 pi pupil_v, which keeps the Sobol points' stratification in (r^2, phi). With K of the
+   N samples in the core, a core sample's weight is multiplied by N c^2 / K and a ring sample's
+   by N (1 - c^2) / (N - K): each stratum's mean times its share of the disk. The axis is then
+   exposed right for every seed, and off it the estimate is unbiased, but for the fit margin's
+   sliver of light when the ring gets no sample (ring_samples). */
 #include "field/strata.h"
 
 #include <math.h>
@@ -65,12 +71,25 @@ static double core_share(const field_strata *t, const camera *c)
     return sum / STEPS;
 }
 
+/* k: the ring's share of the first P samples, in proportion to its share of the disk and
+   leaving the core one at least. With dispersion the ring holds what the other wavelengths
+   pass and gets a sample at least; without, it is only the fit's margin, which passes almost
+   nothing (docs/fields.md), and rounds to none below 64 samples. */
+static int ring_samples(int p, double share, bool dispersion)
+{
+    const long k = lround(p * (1.0 - share));
+    const long least = dispersion ? 1 : 0;
+    return (int)(k < least ? least : k > p - 1 ? p - 1 : k);
+}
+
 void field_strata_count(const camera *c, field_strata *out)
 {
-    *out = (field_strata){.on = false, .core_share = 1.0, .core_scale = 1.0, .ring_scale = 1.0};
+    *out = (field_strata){.on = false};
     sample_batch *b = malloc(sizeof *b);
-    /* other pupils sample the passing region loosely (rear) or not at all (stop, thick) */
-    if (!b || c->pupil.kind != PUPIL_STOP_IMAGE || !pupil_is_fitted(&c->pupil)) {
+    /* other pupils sample the passing region loosely (rear) or not at all (stop, thick); one
+       sample cannot be split */
+    const int n = c->samples.spp;
+    if (!b || c->pupil.kind != PUPIL_STOP_IMAGE || !pupil_is_fitted(&c->pupil) || n < 2) {
         free(b);
         return;
     }
@@ -82,19 +101,18 @@ void field_strata_count(const camera *c, field_strata *out)
         usable = usable && out->core_radius[i] > 0.0;
     }
     free(b);
-    const int n = c->samples.spp;
-    int ring = 0;
-    for (int k = 0; k < n && usable; k++)
-        ring += field_strata_in_ring(out, field_shared_sample(c, k, NULL));
-    if (!usable || ring == n)   /* no core on the axis, or no sample in it: plain */
+    if (!usable)   /* no core on the axis (a central obstruction): nothing to stratify */
         return;
-    out->on = true;
-    out->core_share = core_share(out, c);
-    out->core_scale = n * out->core_share / (n - ring);
-    if (ring > 0)
-        out->ring_scale = n * (1.0 - out->core_share) / ring;
+    int p = 1;
+    while (p <= n / 2)
+        p *= 2;
+    out->ring_from = 1.0 - (double)ring_samples(p, core_share(out, c), c->dispersion) / p;
+    out->samples = n;
+    for (int k = 0; k < n; k++)
+        out->ring_count += field_shared_sample(c, k, NULL).pupil_u >= out->ring_from;
+    out->core_count = n - out->ring_count;
+    out->on = out->core_count > 0;   /* always, by the above */
 }
-
 double field_strata_core_radius(const field_strata *t, double nm)
 {
     const double x = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * (FIELD_STRATA_WAVELENGTHS - 1);
@@ -108,12 +126,18 @@ double field_strata_core_radius(const field_strata *t, double nm)
 
 bool field_strata_in_ring(const field_strata *t, film_sample s)
 {
-    return pupil_disk_radius(s.pupil_u, s.pupil_v) > field_strata_core_radius(t, s.wavelength_nm);
+    return t->on && s.pupil_u >= t->ring_from;
 }
 
-double field_strata_scale(const field_strata *t, film_sample s)
+double field_strata_place(const field_strata *t, film_sample *s)
 {
     if (!t->on)
         return 1.0;
-    return field_strata_in_ring(t, s) ? t->ring_scale : t->core_scale;
+    const double c = field_strata_core_radius(t, s->wavelength_nm), core = c * c;
+    const bool ring = field_strata_in_ring(t, *s);
+    const double r2 = ring ? core + (1.0 - core) * (s->pupil_u - t->ring_from) / (1.0 - t->ring_from)
+                           : core * s->pupil_u / t->ring_from;
+    const double r = sqrt(r2), phi = 2.0 * M_PI * s->pupil_v;
+    pupil_square_of_disk(r * cos(phi), r * sin(phi), &s->pupil_u, &s->pupil_v);
+    return ring ? t->samples * (1.0 - core) / t->ring_count : t->samples * core / t->core_count;
 }

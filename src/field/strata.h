@@ -1,5 +1,6 @@
-/* Post-stratification of the shared pupil points: the core of the pupil that passes whole on
-   the axis, and the ring around it (docs/fields.md, "The exposure"). */
+/* Stratified pupil points for field sampling: the core of the pupil that passes whole on the
+   axis, and the ring around it, each given a fixed share of the shared samples
+   (docs/fields.md, "The exposure"). */
 #ifndef LENS2POV_FIELD_STRATA_H
 #define LENS2POV_FIELD_STRATA_H
 
@@ -10,23 +11,25 @@
 enum { FIELD_STRATA_WAVELENGTHS = 33 };
 
 typedef struct field_strata {
-    bool on;                   /* false: the plain estimate, every scale 1 */
+    bool on;                   /* false: the shared samples as they are, every scale 1 */
     double core_radius[FIELD_STRATA_WAVELENGTHS];   /* on the unit disk; one value without dispersion */
-    double core_share;         /* the core's share of the samples' domain */
-    double core_scale, ring_scale;   /* what a sub-image's weights are multiplied by */
+    double ring_from;          /* a shared sample whose pupil_u is at least this goes to the ring */
+    int samples, core_count, ring_count;   /* the shared samples, and how many go to each stratum */
 } field_strata;
 
-/* Measures the core on camera c's axis and counts its spp shared samples (field_shared_sample)
-   in each stratum. */
+/* Measures the core on camera c's axis and deals its spp shared samples (field_shared_sample)
+   to the strata. */
 void field_strata_count(const camera *c, field_strata *out);
 
 /* The core's radius on the unit disk at this wavelength (any, without dispersion). */
 double field_strata_core_radius(const field_strata *t, double nm);
 
-/* Whether shared sample s falls in the ring. */
+/* Whether shared sample s, as field_shared_sample gives it, goes to the ring. */
 bool field_strata_in_ring(const field_strata *t, film_sample s);
 
-/* The factor for the weights of a sub-image seen with shared sample s. */
-double field_strata_scale(const field_strata *t, film_sample s);
+/* Moves shared sample *s's pupil point into its stratum, uniformly over the stratum's part of
+   the unit disk, and returns the factor for its sub-image's weights: the stratum's share of
+   the disk over its share of the samples. Leaves *s alone and returns 1 when t is off. */
+double field_strata_place(const field_strata *t, film_sample *s);
 
 #endif

@@ -51,7 +51,7 @@ enum { FIELD_COARSEST_CELL = 128, FIELD_BASE_CELL = 32 };
    contains a pixel the lens blocks (or whose film point is beyond the lens's reach, as with
    pixel sampling). out is cleared first; its render size is field_render_size of the crop's.
    weights (NULL, or one a crop pixel, row by row) gets each pixel's sample weight times
-   weight_scale (field_strata_scale), 0 where blocked. Returns L2P_OK, or L2P_FAILED when out
+   weight_scale (field_strata_place), 0 where blocked. Returns L2P_OK, or L2P_FAILED when out
    of memory. */
 int field_build_subimage(const camera *c, film_sample s, double weight_scale,
                          const field_tolerance *t, int base_cell, field_mesh *out, float *weights,
@@ -63,7 +63,7 @@ void field_pixel_raster(const camera *c, film_sample s, long i, double *rx, doub
 
 /* The exact rays of crop pixels first .. first + n - 1 (n <= CAMERA_BATCH) seen with shared
    sample s, into b: each one's film point, ray (camera space), weight (times weight_scale,
-   field_strata_scale), and whether it is rendered: the lens passes it, its film point is
+   field_strata_place), and whether it is rendered: the lens passes it, its film point is
    within the lens's reach (as pixel sampling asks) and the ray and weight are finite. Building a sub-image and the --rays CSV both take
    the rays from here, so that they are the same rays. */
 void field_trace_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
@@ -71,7 +71,8 @@ void field_trace_pixels(const camera *c, film_sample s, double weight_scale, lon
 
 /* Sub-image k's shared sample: point k of the Owen-scrambled Sobol set; with dispersion also
    its wavelength, the bands dealt to the sub-images as pixel sampling deals them to a pixel's
-   samples (sample_pattern_wavelength), and *band (when not NULL) gets its band, 0 without. */
+   samples (sample_pattern_wavelength), and *band (when not NULL) gets its band, 0 without.
+   field_strata_place then moves its pupil point into its stratum. */
 film_sample field_shared_sample(const camera *c, int k, uint32_t *band);
 
 /* The render size for a crop of w x h: the smallest 2^a - 1 >= w, 2^b - 1 >= h, so that UVs

@@ -101,6 +101,24 @@ static inline void disk_point(double u, double v, double *x, double *y)
     *y = r * sin(phi);
 }
 
+/* The forward map's branches read backwards: where |x| >= |y| the square's ring coordinate is
+   a = sign(x) r and b / a = atan(y / x) / (pi / 4); elsewhere b = sign(y) r and
+   a / b = atan(x / y) / (pi / 4). */
+void pupil_square_of_disk(double x, double y, double *u, double *v)
+{
+    const double r = hypot(x, y);
+    double a = 0.0, b = 0.0;
+    if (r > 0.0 && fabs(x) >= fabs(y)) {
+        a = copysign(r, x);
+        b = a * atan(y / x) / (M_PI / 4.0);
+    } else if (r > 0.0) {
+        b = copysign(r, y);
+        a = b * atan(x / y) / (M_PI / 4.0);
+    }
+    *u = 0.5 * (a + 1.0);
+    *v = 0.5 * (b + 1.0);
+}
+
 vec3 pupil_direction(const pupil *pu, vec3 film_point, double x_mm, double y_mm)
 {
     /* A pupil behind the film is a virtual one: the ray leaves the film away from it. */

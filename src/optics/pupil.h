@@ -79,6 +79,10 @@ static inline double pupil_disk_radius(double u, double v)
     return fmax(fabs(2.0 * u - 1.0), fabs(2.0 * v - 1.0));
 }
 
+/* The sample (u, v) whose point on the unit disk is (x, y): the concentric map's inverse, for
+   samplers that place points on the disk themselves (field sampling's strata). */
+void pupil_square_of_disk(double x, double y, double *u, double *v);
+
 /* Grows a fitted pupil so that it also holds every ray that lens l passes: l is the same lens
    at another wavelength (lens_at_wavelength), whose passing regions are those of the fit
    moved and scaled a little. Each node, and each point the fit checks between nodes, grows
