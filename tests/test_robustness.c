@@ -1149,3 +1149,46 @@ Test(robustness, info_refuses_the_lenses_trace_refuses_with_the_same_message)
         remove_tree(dir);
     }
 }
+
+/* A POV-Ray that fails with nothing in its log that says why: the workspace and its logs go
+   with the render, so the message quotes the log's last line and says how to keep the logs;
+   with --keep-temp it names the log, which is there. The stand-in prints what POV-Ray prints
+   around such an end and exits with status 3. */
+Test(robustness, a_povray_failure_without_a_reason_quotes_its_log)
+{
+    const char *dir = test_tmpdir();
+    char *scene = strdup(tmp_path(dir, "scene.pov")), *fake = strdup(tmp_path(dir, "fakepov"));
+    char *image = strdup(tmp_path(dir, "img.png")), *kept = strdup(tmp_path(dir, "kept"));
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb 1 }\n");
+    write_text(fake, "#!/bin/sh\necho 'Parsing 1K tokens'\necho 'Render failed'\nexit 3\n");
+    cr_assert_eq(chmod(fake, 0755), 0);
+    static const char *const samplings[] = {"pixel", "field"};
+    for (int k = 0; k < 2; k++)
+        for (int keep = 0; keep < 2; keep++) {
+            cr_assert_eq(setenv("LENS2POV_POVRAY", fake, 1), 0);
+            char *args[] = {"render", scene, DGAUSS, "--width", "16", "--height", "12", "--spp", "2",
+                            "--sampling", (char *)samplings[k], "-o", image, "--quiet",
+                            keep ? "--keep-temp" : NULL, kept, NULL};
+            char *errtext = NULL;
+            const int status = run_lens2pov_argv(NULL, &errtext, args);
+            cr_assert_eq(unsetenv("LENS2POV_POVRAY"), 0);
+            cr_expect_eq(status, 1, "%s: %s", samplings[k], errtext);
+            cr_expect(errtext && strstr(errtext, "failed with status 3"), "%s", errtext);
+            const char *log = errtext ? strstr(errtext, "log: ") : NULL;
+            if (keep) {
+                char path[4096] = "";
+                if (log)
+                    sscanf(log + 5, "%4095[^)]", path);
+                cr_expect(log && strncmp(path, kept, strlen(kept)) == 0 && file_exists(path),
+                          "%s: %s", samplings[k], errtext);
+            } else {
+                cr_expect(!log && strstr(errtext, "its log ends \"Render failed\"") &&
+                              strstr(errtext, "--keep-temp"), "%s: %s", samplings[k], errtext);
+            }
+            cr_expect(!file_exists(image));
+            free(errtext);
+            if (keep)
+                remove_tree(kept);
+        }
+    free(scene), free(fake), free(image), free(kept);
+}

@@ -323,7 +323,7 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
                                    !c->quiet, NULL, chunks_ready, &w, c->povray_args,
                                    c->povray_arg_count, c->cam.width, c->cam.height,
-                                   load_image_library, NULL, frame_picture_done, &d};
+                                   load_image_library, NULL, frame_picture_done, &d, ws->keep};
         if (!st)
             st = povray_render_chunks(pc, count * tf->count, &po, err);
         if (st)
@@ -368,7 +368,7 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
     const field_render_options fo = {c->positional[0], ws->dir, prefix, fr, tf->count, tf->digits,
                                      c->povray_args, c->povray_arg_count, jobs, cores_online(),
                                      !c->quiet, c->field_tolerance, with_csv ? csv : NULL,
-                                     &too_fine, load_image_library};
+                                     &too_fine, load_image_library, ws->keep};
     const int st = field_render(cam, &fo, err);
     free(fr);
     if (st == L2P_BAD_INPUT && too_fine && !c->sampling_chosen) {

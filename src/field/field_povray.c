@@ -208,7 +208,7 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                .jobs = o->jobs, .threads_per_job = o->threads_per_job,
                                .show_progress = o->progress, .user_args = o->povray_args,
                                .user_arg_count = o->povray_arg_count,
-                               .started = o->povray_started,
+                               .started = o->povray_started, .work_dir_kept = o->work_dir_kept,
                                .film_width = c->film.width, .film_height = c->film.height};
     const bool one_run_a_job = !o->povray_args && o->frame_count == 1 && o->frames[0].number < 0;
     povray_chunk *pc = st || one_run_a_job ? NULL : frame_chunks(&f, o);

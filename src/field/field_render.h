@@ -36,6 +36,7 @@ typedef struct field_render_options {
                                   draw (more faces than pixels, or finer than float32);
                                   NULL: not asked */
     void (*povray_started)(void *ctx);   /* povray_options.started's, with no context */
+    bool work_dir_kept;        /* povray_options.work_dir_kept's */
 } field_render_options;
 
 /* --field-tolerance's default, in pixels: no picture shows an error this small. */

@@ -151,6 +151,22 @@ static void stop_jobs(run *r)
 
 /* Why a job failed, in POV-Ray's own words when its log has them (a sequence's: those of the
    frame it failed in). */
+/* Where to look further: the log, if it outlives the run; else its last line, since the
+   workspace goes with the run. */
+static void log_hint(const run *r, const job *j, char *out, size_t n)
+{
+    if (r->opts->work_dir_kept) {
+        snprintf(out, n, "log: %s", j->log_path);
+        return;
+    }
+    char last[160];
+    povray_log_last_line(j->log_path, last, sizeof last);
+    if (last[0])
+        snprintf(out, n, "its log ends \"%s\"; --keep-temp DIR keeps the logs", last);
+    else
+        snprintf(out, n, "its log is empty; --keep-temp DIR keeps the logs");
+}
+
 static int explain_failure(const run *r, job *j, int status, l2p_error *err)
 {
     if (r->frames)
@@ -164,11 +180,13 @@ static int explain_failure(const run *r, job *j, int status, l2p_error *err)
     free(wrapper);
     if (st)
         return st;
+    char hint[256];
+    log_hint(r, j, hint, sizeof hint);
     if (WIFSIGNALED(status))
-        return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: killed by signal %d (log: %s)",
-                        WTERMSIG(status), j->log_path);
-    return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: failed with status %d (log: %s)",
-                    WIFEXITED(status) ? WEXITSTATUS(status) : -1, j->log_path);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: killed by signal %d (%s)",
+                        WTERMSIG(status), hint);
+    return l2p_fail(err, L2P_FAILED, NULL, 0, "povray: failed with status %d (%s)",
+                    WIFEXITED(status) ? WEXITSTATUS(status) : -1, hint);
 }
 
 /* A finished job: success needs exit status 0 and the EXR on disk; a sequence's frames not
@@ -186,9 +204,11 @@ static int check_finished(run *r, job *j, int status, l2p_error *err)
         const char *written = frame ? frame : r->chunks[k].output_exr;
         if (r->frames && !frame)
             st = povray_out_of_memory(err);
-        else if (access(written, R_OK) != 0)
-            st = l2p_fail(err, L2P_FAILED, written, 0,
-                          "POV-Ray finished without writing it (log: %s)", j->log_path);
+        else if (access(written, R_OK) != 0) {
+            char hint[256];
+            log_hint(r, j, hint, sizeof hint);
+            st = l2p_fail(err, L2P_FAILED, written, 0, "POV-Ray finished without writing it (%s)", hint);
+        }
         else
             st = povray_picture_finished(r, k, written, err);
         free(frame);

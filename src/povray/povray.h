@@ -57,6 +57,8 @@ typedef struct povray_options {
        the run, with err set. NULL: none. */
     int (*picture_done)(void *ctx, int k, l2p_error *err);
     void *picture_ctx;
+    bool work_dir_kept;        /* work_dir outlives the run (--keep-temp): a message may name a
+                                  log there; else it quotes the log's last line */
 } povray_options;
 
 /* Writes, for every chunk, a wrapper that includes the scene and then the chunk's camera, and

@@ -36,6 +36,26 @@ static char *read_tail(const char *path, long len)
     return s;
 }
 
+void povray_log_last_line(const char *log_path, char *out, size_t n)
+{
+    if (n == 0)
+        return;
+    char *s = read_tail(log_path, PROGRESS_TAIL);
+    size_t end = s ? strlen(s) : 0;
+    while (end > 0 && strchr(" \t\r\n", s[end - 1]))
+        end--;
+    size_t start = end;
+    while (start > 0 && s[start - 1] != '\n' && s[start - 1] != '\r')
+        start--;
+    while (start < end && (s[start] == ' ' || s[start] == '\t'))
+        start++;
+    const size_t len = end - start < n - 1 ? end - start : n - 1;
+    if (len)
+        memcpy(out, s + start, len);
+    out[len] = '\0';
+    free(s);
+}
+
 /* An animation announces each frame on a line "Rendering frame F of N" (twice for the first):
    the text after the last such line in s, or s. */
 static char *current_frame(char *s, int *frame)

@@ -3,6 +3,7 @@
 #define LENS2POV_POVRAY_LOG_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include "base/error.h"
 
 typedef struct povray_path_link {
@@ -38,6 +39,10 @@ bool povray_log_transient(const char *log_path);
    starts again: when it failed for that passing cause, at most seven times. It then warns on
    stderr and pauses first (0.1 s, doubling with each retry). */
 bool povray_retry_transient(const char *log_path, int retries_made);
+
+/* The log's last line that is not blank, without its end of line, cut to n - 1 bytes; "" when
+   the log is empty or unreadable. */
+void povray_log_last_line(const char *log_path, char *out, size_t n);
 
 /* The frame an animation's log is at ("Rendering frame F of N"), or frame when its tail
    names none. */
