@@ -15,10 +15,34 @@
 static const char *const LENSES[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm", "telephoto.250mm", "takumar.50mm"};
 enum { LENS_COUNT = 5 };
 
+/* The stratified cases: the stop-image pupil of the four standard lenses and one of real glass
+   at the d line, and of that one with dispersion; the rear pupil of two at the d line and of
+   the real glass with dispersion. */
+typedef struct exposure_case {
+    const char *lens;
+    pupil_kind pupil;
+    bool spectral;
+} exposure_case;
+static const exposure_case CASES[] = {
+    {"dgauss.50mm", PUPIL_STOP_IMAGE, false}, {"wide.22mm", PUPIL_STOP_IMAGE, false},
+    {"fisheye.10mm", PUPIL_STOP_IMAGE, false}, {"telephoto.250mm", PUPIL_STOP_IMAGE, false},
+    {"takumar.50mm", PUPIL_STOP_IMAGE, false}, {"takumar.50mm", PUPIL_STOP_IMAGE, true},
+    {"dgauss.50mm", PUPIL_REAR, false}, {"telephoto.250mm", PUPIL_REAR, false},
+    {"takumar.50mm", PUPIL_REAR, true}};
+enum { CASE_COUNT = sizeof CASES / sizeof CASES[0] };
+
+static const char *case_name(const exposure_case *k)
+{
+    static char s[128];
+    snprintf(s, sizeof s, "%s, %s pupil%s", k->lens, k->pupil == PUPIL_REAR ? "rear" : "stop-image",
+             k->spectral ? ", with dispersion" : "");
+    return s;
+}
+
 /* A 64 x 48 film, focused at 3 m, physical weights, stopped to f_number (NAN: the full
    opening). */
-static void setup(camera *c, const char *name, double f_number, int spp, uint64_t seed,
-                  dispersion_mode dispersion)
+static void setup_pupil(camera *c, const char *name, pupil_kind pupil, double f_number, int spp,
+                        uint64_t seed, dispersion_mode dispersion)
 {
     camera_options o;
     camera_options_default(&o);
@@ -30,7 +54,19 @@ static void setup(camera *c, const char *name, double f_number, int spp, uint64_
     o.focus_distance_units = 3.0;
     o.weighting = WEIGHTING_PHYSICAL;
     o.dispersion = dispersion;
+    o.pupil = pupil;
     test_camera(c, name, &o);
+}
+
+static void setup(camera *c, const char *name, double f_number, int spp, uint64_t seed,
+                  dispersion_mode dispersion)
+{
+    setup_pupil(c, name, PUPIL_STOP_IMAGE, f_number, spp, seed, dispersion);
+}
+
+static void setup_case(camera *c, const exposure_case *k, double f_number, int spp, uint64_t seed)
+{
+    setup_pupil(c, k->lens, k->pupil, f_number, spp, seed, k->spectral ? DISPERSION_ON : DISPERSION_OFF);
 }
 
 /* Whether the ray from the film's centre with direction cosines (a, 0) gets through. */
@@ -100,10 +136,11 @@ static bool trace_at(const camera *c, vec3 p, double u, double v, double nm, dou
 /* What field sampling gives the film's centre from a background of radiance 1: the mean over
    the spp shared samples of their weights there, placed in their strata. The point is the axis
    itself; a pixel's film points move off it with the shared pixel offsets. */
-static double field_centre(const camera *c)
+static double field_centre(const camera *c, int *core_count)
 {
     field_strata t;
     field_strata_count(c, &t);
+    *core_count = t.on ? t.core_count : c->samples.spp;
     double sum = 0.0, w;
     for (int k = 0; k < c->samples.spp; k++) {
         film_sample s = field_shared_sample(c, k, NULL);
@@ -128,15 +165,14 @@ Test(field_exposure, the_film_centre_is_exposed_right_for_every_seed)
     static const double F_NUMBERS[] = {NAN, 8.0};
     static const int SPP[] = {16, 64};
     static const double PER_SPREAD[] = {1.0 / 10.0, 1.0 / 30.0};
-    for (int i = 0; i <= LENS_COUNT; i++)
+    for (int i = 0; i < CASE_COUNT; i++)
         for (int f = 0; f < 2; f++)
             for (int n = 0; n < 2; n++) {
-                const bool spectral = i == LENS_COUNT;   /* the last lens again, with dispersion */
-                const char *name = LENSES[spectral ? LENS_COUNT - 1 : i];
+                const bool spectral = CASES[i].spectral;
                 double expected = 0.0, tolerance = 0.0;
                 for (uint64_t seed = 1; seed <= 8; seed++) {
                     camera c;
-                    setup(&c, name, F_NUMBERS[f], SPP[n], seed, spectral ? DISPERSION_ON : DISPERSION_OFF);
+                    setup_case(&c, &CASES[i], F_NUMBERS[f], SPP[n], seed);
                     if (seed == 1) {
                         expected = centre_irradiance_spectral(&c);
                         const double cos2 = 1.0 - expected / M_PI;   /* E = pi sin^2(alpha) */
@@ -152,26 +188,32 @@ Test(field_exposure, the_film_centre_is_exposed_right_for_every_seed)
                             lens_free(&blue), lens_free(&red);
                         }
                     }
-                    const double got = field_centre(&c);
-                    cr_expect(fabs(got / expected - 1.0) <= tolerance,
-                              "%s%s f/%g, %d spp, seed %d: %.6g against %.6g (%.2e, allowed %.2e)", name,
-                              spectral ? " with dispersion" : "", F_NUMBERS[f], SPP[n], (int)seed, got,
-                              expected, got / expected - 1.0, tolerance);
+                    int core;
+                    const double got = field_centre(&c, &core);
+                    /* the error is the core's: its points carry the light on the axis */
+                    const double allowed = tolerance * SPP[n] / core;
+                    cr_expect(fabs(got / expected - 1.0) <= allowed,
+                              "%s, f/%g, %d spp, seed %d: %.6g against %.6g (%.2e, allowed %.2e)",
+                              case_name(&CASES[i]), F_NUMBERS[f], SPP[n], (int)seed, got,
+                              expected, got / expected - 1.0, allowed);
                     camera_free(&c);
                 }
             }
 }
 
-/* On the axis the fitted region is a disk grown by the fit's margin, exactly: the core is
-   1 / PUPIL_FIT_MARGIN of the unit disk, to the fit's bisection. Every seed deals the first
-   2^m shared samples alike, the ring about its share of the disk (with dispersion one at
-   least) and the core one at least; each sample lands in its stratum's part of the disk. The rear and stop
-   pupils, thick tracing and a single sample keep the shared samples as they are. */
+/* On the axis the stop-image pupil's region is a disk grown by the fit's margin, exactly: the
+   core is 1 / PUPIL_FIT_MARGIN of the unit disk, to the fit's bisection. Every seed deals the
+   first 2^m shared samples alike, the ring about its share of the disk (one at least, but for
+   the stop-image pupil at the d line, whose ring is only that margin) and the core one at
+   least; each sample lands in its stratum's part of the disk. The stop pupil, thick tracing
+   and a single sample keep the shared samples as they are. */
 Test(field_exposure, the_strata_get_fixed_shares)
 {
     static const int SPP[] = {2, 16, 24, 64, 100, 256, 1024};
     for (int n = 0; n < 7; n++)
-        for (int spectral = 0; spectral < 2; spectral++) {
+        for (int v = 0; v < 3; v++) {
+            const exposure_case *e = &CASES[(int[]){0, 5, 6}[v]];   /* d line, dispersion, rear */
+            const bool spectral = e->spectral, margin_only = e->pupil == PUPIL_STOP_IMAGE && !spectral;
             const int spp = SPP[n];
             int p = 1;
             while (2 * p <= spp)
@@ -179,12 +221,11 @@ Test(field_exposure, the_strata_get_fixed_shares)
             int first_ring = -1;
             for (uint64_t seed = 1; seed <= 4; seed++) {
                 camera c;
-                setup(&c, spectral ? "takumar.50mm" : "dgauss.50mm", NAN, spp, seed,
-                      spectral ? DISPERSION_ON : DISPERSION_OFF);
+                setup_case(&c, e, NAN, spp, seed);
                 field_strata t;
                 field_strata_count(&c, &t);
-                cr_assert(t.on, "%d spp", spp);
-                if (!spectral)
+                cr_assert(t.on, "%s, %d spp", case_name(e), spp);
+                if (margin_only)
                     cr_expect(fabs(field_strata_core_radius(&t, 587.6) * PUPIL_FIT_MARGIN - 1.0) < 1e-6,
                               "core %.9g", field_strata_core_radius(&t, 587.6));
                 /* the ring's share of the first p samples, and of the disk over the spectrum */
@@ -206,24 +247,26 @@ Test(field_exposure, the_strata_get_fixed_shares)
                               ring ? "ring" : "core");
                     cr_expect(scale > 0.0 && isfinite(scale), "%d spp, sample %d: scale %g", spp, k, scale);
                 }
-                cr_expect(t.ring_count >= spectral && t.core_count >= 1 && t.ring_count + t.core_count == spp,
-                          "%d spp: %d in the ring, %d in the core", spp, t.ring_count, t.core_count);
+                cr_expect(t.ring_count >= !margin_only && t.core_count >= 1 && t.ring_count + t.core_count == spp,
+                          "%s, %d spp: %d in the ring, %d in the core", case_name(e), spp, t.ring_count,
+                          t.core_count);
                 if (first_ring < 0)
                     first_ring = ring_p;
                 cr_expect_eq(ring_p, first_ring, "%d spp, seed %d: %d of the first %d in the ring, seed 1 %d",
                              spp, (int)seed, ring_p, p, first_ring);
-                /* in proportion; with dispersion at least one */
+                /* in proportion, one at least but for the margin, leaving the core one; with
+                   dispersion ring_disk is averaged as the code does, to a rounding */
                 const long share = lround(p * ring_disk);
-                cr_expect(spectral ? ring_p >= 1 && ring_p >= share && ring_p <= share + 1
-                                   : ring_p == (share < p - 1 ? share : p - 1),
-                          "%d spp: %d of %d in the ring, which is %.4f of the disk", spp, ring_p, p,
-                          ring_disk);
+                const long want = share < !margin_only ? !margin_only : share > p - 1 ? p - 1 : share;
+                cr_expect(labs(ring_p - want) <= spectral,
+                          "%s, %d spp: %d of %d in the ring, which is %.4f of the disk", case_name(e), spp,
+                          ring_p, p, ring_disk);
                 camera_free(&c);
             }
         }
     static const struct { pupil_kind p; trace_kind trace; int spp; } PLAIN[] = {
-        {PUPIL_REAR, TRACE_KIND_FULL, 256}, {PUPIL_STOP, TRACE_KIND_FULL, 256},
-        {PUPIL_STOP_IMAGE, TRACE_KIND_THICK, 256}, {PUPIL_STOP_IMAGE, TRACE_KIND_FULL, 1}};
+        {PUPIL_STOP, TRACE_KIND_FULL, 256}, {PUPIL_STOP_IMAGE, TRACE_KIND_THICK, 256},
+        {PUPIL_REAR, TRACE_KIND_FULL, 1}, {PUPIL_STOP_IMAGE, TRACE_KIND_FULL, 1}};
     for (int i = 0; i < 4; i++) {
         camera_options o;
         camera_options_default(&o);
@@ -253,11 +296,15 @@ static double next_unit(uint64_t *s)
    square, each point as it is (t NULL: the plain estimate) or placed in its stratum and
    scaled: both are estimates of the irradiance there, by two parametrizations of the pupil.
    (A jittered grid and not midpoints: the ring beyond the core is thinner than a cell, and
-   midpoints would put whole rows of cells in it or out of it.) */
-static double grid_mean(const camera *c, const field_strata *t, vec3 p, double nm, int g, uint64_t *state)
+   midpoints would put whole rows of cells in it or out of it.) *std_error gets the standard
+   error, from neighbouring cells taken in pairs (Cochran, "Sampling techniques", 1977, section
+   5A.12: collapsed strata; a cell the region's edge cuts counts as a pair that differs by all
+   of f, which overstates the error there about twice). */
+static double grid_mean(const camera *c, const field_strata *t, vec3 p, double nm, int g, uint64_t *state,
+                        double *std_error)
 {
     sample_batch *b = malloc(sizeof *b);
-    double sum = 0.0, scale[CAMERA_BATCH];
+    double sum = 0.0, pairs = 0.0, scale[CAMERA_BATCH];
     for (long start = 0; start < (long)g * g; start += CAMERA_BATCH) {
         b->n = (int)((long)g * g - start < CAMERA_BATCH ? (long)g * g - start : CAMERA_BATCH);
         for (int k = 0; k < b->n; k++) {
@@ -269,33 +316,44 @@ static double grid_mean(const camera *c, const field_strata *t, vec3 p, double n
             b->wavelength_nm[k] = nm;
         }
         camera_trace_batch(c, b);
-        for (int k = 0; k < b->n; k++)
-            if (b->passed[k])
-                sum += b->weight[k] * scale[k];
+        double f[CAMERA_BATCH];
+        for (int k = 0; k < b->n; k++) {
+            f[k] = b->passed[k] ? b->weight[k] * scale[k] : 0.0;
+            sum += f[k];
+            if (k % 2)   /* g and CAMERA_BATCH are even: k - 1 is its neighbour in the row */
+                pairs += (f[k] - f[k - 1]) * (f[k] - f[k - 1]);
+        }
     }
     free(b);
-    return sum / ((double)g * g);
+    const double n = (double)g * g;
+    *std_error = sqrt(pairs) / n;
+    return sum / n;
 }
 
 /* Off the axis the ring passes light too (with dispersion up to 1.2% of the Takumar's corner
-   at 780 nm, and the fit's bulges at the d line); the strata must count it with its share.
-   With 256 shared samples (a power of two, so the strata get exactly their shares of any
-   uniform points, and enough that the ring gets some at the d line too) the placed and scaled points estimate the irradiance the plain ones do, at
-   film radii from the centre to the corner, full aperture and f/8. Both estimates are jittered
-   grids whose error is at the vignetting's edges: they differ by at most 5.4e-4 of the light at
-   g = 256 (measured); allowed 1e-3, and 3e-3 at the sanitizers' g = 128. Leaving the ring out
+   at 780 nm, the fit's bulges at the d line, much of the rear pupil's off-axis regions); the
+   strata must count it with its share. With 256 shared samples (a power of two, so the strata
+   get exactly their shares of any uniform points, and enough that the ring gets some at the d
+   line too) the placed and scaled points estimate the irradiance the plain ones do, at film
+   radii from the centre to the corner, full aperture and f/8 (the rear pupil at full aperture
+   only: at f/8 too few of the grid's points pass its disk). Both estimates are jittered grids
+   whose error is at the vignetting's edges; allowed 1e-3 (3e-3 at the sanitizers' g = 128)
+   plus two of their standard errors as grid_mean overstates them. Measured at g = 256: at most
+   6.7e-4 of the light for the stop-image pupil and 1.2e-3 for the rear. Leaving the ring out
    fails by 1.2%. */
 Test(field_exposure, the_strata_integrate_what_the_whole_pupil_does)
 {
     const int g = FULL_OR_ASAN(256, 128);
     const double tolerance = FULL_OR_ASAN(1e-3, 3e-3);
-    double worst = 0.0;
-    for (int i = 0; i <= LENS_COUNT; i++)
+    double worst = 0.0, worst_off = 0.0;
+    for (int i = 0; i < CASE_COUNT; i++)
         for (int f = 0; f < 2; f++) {
-            const bool spectral = i == LENS_COUNT;
-            const char *name = LENSES[spectral ? LENS_COUNT - 1 : i];
+            const bool spectral = CASES[i].spectral;
+            const char *name = case_name(&CASES[i]);
             camera c;
-            setup(&c, name, f ? 8.0 : NAN, 256, 1, spectral ? DISPERSION_ON : DISPERSION_OFF);
+            if (f && CASES[i].pupil == PUPIL_REAR)   /* too few of the grid's points pass */
+                continue;
+            setup_case(&c, &CASES[i], f ? 8.0 : NAN, 256, 1);
             field_strata t;
             field_strata_count(&c, &t);
             uint64_t state = 12345;
@@ -305,18 +363,21 @@ Test(field_exposure, the_strata_integrate_what_the_whole_pupil_does)
                 for (int w = 0; w < (spectral ? 3 : 1); w++) {
                     const vec3 p = v3(0.1 * j * c.film.diagonal_mm, 0.0, 0.0);
                     const double nm = spectral ? (double[]){SPECTRUM_MIN_NM, 587.6, SPECTRUM_MAX_NM}[w] : 587.6;
-                    const double plain = grid_mean(&c, NULL, p, nm, g, &state);
-                    const double strata = grid_mean(&c, &t, p, nm, g, &state);
+                    double se_plain, se_strata;
+                    const double plain = grid_mean(&c, NULL, p, nm, g, &state, &se_plain);
+                    const double strata = grid_mean(&c, &t, p, nm, g, &state, &se_strata);
                     if (!(plain > 0.0))
                         continue;
                     const double off = fabs(strata / plain - 1.0);
-                    worst = fmax(worst, off);
-                    cr_expect(off <= tolerance, "%s f/%s, film radius %.2f mm, %g nm: %.6g against %.6g",
-                              name, f ? "8" : "full", p.x, nm, strata, plain);
+                    const double allowed = tolerance + 2.0 * hypot(se_plain, se_strata) / plain;
+                    worst = fmax(worst, off / allowed);
+                    worst_off = fmax(worst_off, off);
+                    cr_expect(off <= allowed, "%s f/%s, film radius %.2f mm, %g nm: %.6g against %.6g (allowed %.2e)",
+                              name, f ? "8" : "full", p.x, nm, strata, plain, allowed);
                 }
             camera_free(&c);
         }
-    cr_log_info("worst %.2e", worst);
+    cr_log_info("worst %.2e, %.2f of the allowed", worst_off, worst);
 }
 
 /* A point of the square's ring beyond lo (the unit disk's beyond radius lo), uniform in area:

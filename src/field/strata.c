@@ -1,6 +1,7 @@
 /* Every pixel of a field render sees the same N shared pupil points. On the axis the passing
-   region is a disk, but the stop-image pupil samples a larger one: the fit's last growth
-   (PUPIL_FIT_MARGIN) and, with dispersion, the growth that holds every wavelength's region. A
+   region is a disk, but the pupil samples a larger one: the rear pupil's disk holds the rear
+   rim, the stop-image pupil's has the fit's last growth (PUPIL_FIT_MARGIN), and with
+   dispersion both grow to hold every wavelength's region. A
    point beyond the passing disk is blocked at every pixel near the axis at once, so with the
    plain estimate (1 / N) sum f the whole picture came out (N - M) / (N s) of the truth, M the
    points the seed put there and s the disk's share of the pupil: a few percent off, by seed.
@@ -16,7 +17,8 @@
    N samples in the core, a core sample's weight is multiplied by N c^2 / K and a ring sample's
    by N (1 - c^2) / (N - K): each stratum's mean times its share of the disk. The axis is then
    exposed right for every seed, and off it the estimate is unbiased, but for the fit margin's
-   sliver of light when the ring gets no sample (ring_samples). */
+   sliver of light when the ring gets no sample (ring_samples). The rear pupil, a disk about
+   the axis, is stratified alike. */
 #include "field/strata.h"
 
 #include <math.h>
@@ -72,13 +74,15 @@ static double core_share(const field_strata *t, const camera *c)
 }
 
 /* k: the ring's share of the first P samples, in proportion to its share of the disk and
-   leaving the core one at least. With dispersion the ring holds what the other wavelengths
-   pass and gets a sample at least; without, it is only the fit's margin, which passes almost
-   nothing (docs/fields.md), and rounds to none below 64 samples. */
-static int ring_samples(int p, double share, bool dispersion)
+   leaving the core one at least. The ring of a stop-image pupil at one wavelength is only the
+   fit's margin around the region's own shape, which passes almost nothing (docs/fields.md),
+   and rounds to none below 64 samples. Elsewhere it gets one at least: with dispersion it holds
+   what the other wavelengths pass, and the rear pupil's disk about the axis holds the regions
+   off it. */
+static int ring_samples(int p, double share, bool margin_only)
 {
     const long k = lround(p * (1.0 - share));
-    const long least = dispersion ? 1 : 0;
+    const long least = margin_only ? 0 : 1;
     return (int)(k < least ? least : k > p - 1 ? p - 1 : k);
 }
 
@@ -86,10 +90,12 @@ void field_strata_count(const camera *c, field_strata *out)
 {
     *out = (field_strata){.on = false};
     sample_batch *b = malloc(sizeof *b);
-    /* other pupils sample the passing region loosely (rear) or not at all (stop, thick); one
-       sample cannot be split */
+    /* the stop pupil and thick tracing fit no region (every sample passes the axis or none
+       is known to); one sample cannot be split */
     const int n = c->samples.spp;
-    if (!b || c->pupil.kind != PUPIL_STOP_IMAGE || !pupil_is_fitted(&c->pupil) || n < 2) {
+    const bool fitted = (c->pupil.kind == PUPIL_STOP_IMAGE || c->pupil.kind == PUPIL_REAR) &&
+                        pupil_is_fitted(&c->pupil);
+    if (!b || !fitted || n < 2) {
         free(b);
         return;
     }
@@ -101,18 +107,22 @@ void field_strata_count(const camera *c, field_strata *out)
         usable = usable && out->core_radius[i] > 0.0;
     }
     free(b);
-    if (!usable)   /* no core on the axis (a central obstruction): nothing to stratify */
+    const double share = usable ? core_share(out, c) : 0.0;
+    /* no core on the axis (a central obstruction), or no ring (the whole disk passes) */
+    if (!usable || !(share < 1.0))
         return;
     int p = 1;
     while (p <= n / 2)
         p *= 2;
-    out->ring_from = 1.0 - (double)ring_samples(p, core_share(out, c), c->dispersion) / p;
+    const bool margin_only = c->pupil.kind == PUPIL_STOP_IMAGE && !c->dispersion;
+    out->ring_from = 1.0 - (double)ring_samples(p, share, margin_only) / p;
     out->samples = n;
     for (int k = 0; k < n; k++)
         out->ring_count += field_shared_sample(c, k, NULL).pupil_u >= out->ring_from;
     out->core_count = n - out->ring_count;
     out->on = out->core_count > 0;   /* always, by the above */
 }
+
 double field_strata_core_radius(const field_strata *t, double nm)
 {
     const double x = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * (FIELD_STRATA_WAVELENGTHS - 1);
