@@ -1,24 +1,24 @@
 /* Every pixel of a field render sees the same N shared pupil points. On the axis the passing
    region is a disk, but the pupil samples a larger one: the rear pupil's disk holds the rear
    rim, the stop-image pupil's has the fit's last growth (PUPIL_FIT_MARGIN), and with
-   dispersion both grow to hold every wavelength's region. A
-   point beyond the passing disk is blocked at every pixel near the axis at once, so with the
-   plain estimate (1 / N) sum f the whole picture came out (N - M) / (N s) of the truth, M the
-   points the seed put there and s the disk's share of the pupil: a few percent off, by seed.
+   dispersion both grow to hold every wavelength's region. A point beyond the passing disk is
+   blocked at every pixel near the axis at once, so with the plain estimate (1 / N) sum f the
+   whole picture came out (N - M) / (N s) of the truth, M the points the seed put there and s
+   the disk's share of the pupil: a few percent off, by seed.
 
    So the shared points are stratified (Owen, "Monte Carlo theory, methods and examples", 2013,
-   section 8.4) over the core, the disk that passes on the axis (radius c(lambda) on
-   the unit disk, measured here), and the ring around it. The stratum comes from pupil_u alone:
-   a shared sample with pupil_u >= 1 - q goes to the ring. In the first P = 2^m samples each
-   interval of width 2^-m holds one pupil_u (sobol.h), so with q = k / P exactly k of them go to
-   the ring, whatever the seed. A sample is then placed uniformly in its stratum by the equal-area
-   polar map, r^2 = c^2 u / (1 - q) in the core and c^2 + (1 - c^2) (u - 1 + q) / q in the ring,
-   phi = 2 pi pupil_v, which keeps the Sobol points' stratification in (r^2, phi). With K of the
-   N samples in the core, a core sample's weight is multiplied by N c^2 / K and a ring sample's
-   by N (1 - c^2) / (N - K): each stratum's mean times its share of the disk. The axis is then
-   exposed right for every seed, and off it the estimate is unbiased, but for the fit margin's
-   sliver of light when the ring gets no sample (ring_samples). The rear pupil, a disk about
-   the axis, is stratified alike. */
+   section 8.4) over the core, the disk that passes on the axis (radius c(lambda) on the unit
+   disk, measured here), and the ring around it. The stratum comes from pupil_u alone: a
+   shared sample with pupil_u >= 1 - q goes to the ring. In the first P = 2^m samples each
+   interval of width 2^-m holds one pupil_u (sobol.h), so with q = k / P exactly k of them go
+   to the ring, whatever the seed. A sample is then placed uniformly in its stratum by the
+   equal-area polar map, r^2 = c^2 u / (1 - q) in the core and c^2 + (1 - c^2) (u - 1 + q) / q
+   in the ring, phi = 2 pi pupil_v, which keeps the Sobol points' stratification in
+   (r^2, phi). With K of the N samples in the core, a core sample's weight is multiplied by
+   N c^2 / K and a ring sample's by N (1 - c^2) / (N - K): each stratum's mean times its share
+   of the disk. The axis is then exposed right for every seed, and off it the estimate is
+   unbiased, but for the fit margin's sliver of light when the ring gets no sample
+   (ring_samples). */
 #include "field/strata.h"
 
 #include <math.h>

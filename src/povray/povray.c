@@ -149,8 +149,6 @@ static void stop_jobs(run *r)
     }
 }
 
-/* Why a job failed, in POV-Ray's own words when its log has them (a sequence's: those of the
-   frame it failed in). */
 /* Where to look further: the log, if it outlives the run; else its last line, since the
    workspace goes with the run. */
 static void log_hint(const run *r, const job *j, char *out, size_t n)
@@ -167,6 +165,8 @@ static void log_hint(const run *r, const job *j, char *out, size_t n)
         snprintf(out, n, "its log is empty; --keep-temp DIR keeps the logs");
 }
 
+/* Why a job failed, in POV-Ray's own words when its log has them (a sequence's: those of the
+   frame it failed in). */
 static int explain_failure(const run *r, job *j, int status, l2p_error *err)
 {
     if (r->frames)
@@ -208,9 +208,9 @@ static int check_finished(run *r, job *j, int status, l2p_error *err)
             char hint[256];
             log_hint(r, j, hint, sizeof hint);
             st = l2p_fail(err, L2P_FAILED, written, 0, "POV-Ray finished without writing it (%s)", hint);
-        }
-        else
+        } else {
             st = povray_picture_finished(r, k, written, err);
+        }
         free(frame);
     }
     return st;
