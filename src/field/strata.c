@@ -116,7 +116,6 @@ void field_strata_count(const camera *c, field_strata *out)
         p *= 2;
     const bool margin_only = c->pupil.kind == PUPIL_STOP_IMAGE && !c->dispersion;
     out->ring_from = 1.0 - (double)ring_samples(p, share, margin_only) / p;
-    out->samples = n;
     for (int k = 0; k < n; k++)
         out->ring_count += field_shared_sample(c, k, NULL).pupil_u >= out->ring_from;
     out->core_count = n - out->ring_count;
@@ -149,5 +148,6 @@ double field_strata_place(const field_strata *t, film_sample *s)
                            : core * s->pupil_u / t->ring_from;
     const double r = sqrt(r2), phi = 2.0 * M_PI * s->pupil_v;
     pupil_square_of_disk(r * cos(phi), r * sin(phi), &s->pupil_u, &s->pupil_v);
-    return ring ? t->samples * (1.0 - core) / t->ring_count : t->samples * core / t->core_count;
+    const int n = t->core_count + t->ring_count;
+    return ring ? n * (1.0 - core) / t->ring_count : n * core / t->core_count;
 }

@@ -14,7 +14,7 @@ typedef struct field_strata {
     bool on;                   /* false: the shared samples as they are, every scale 1 */
     double core_radius[FIELD_STRATA_WAVELENGTHS];   /* on the unit disk; one value without dispersion */
     double ring_from;          /* a shared sample whose pupil_u is at least this goes to the ring */
-    int samples, core_count, ring_count;   /* the shared samples, and how many go to each stratum */
+    int core_count, ring_count;   /* how many of the shared samples go to each stratum */
 } field_strata;
 
 /* Measures the core on camera c's axis and deals its spp shared samples (field_shared_sample)
