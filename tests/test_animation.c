@@ -86,6 +86,51 @@ Test(animation, field_frames_named_as_povray_traced_once)
     frames_match_povray("field", "field.map");
 }
 
+/* Without --keep-temp a field animation's renders go from the work folder once their frame is
+   developed. Four samples of a 48x36 film make one render a frame at --jobs 1, so a POV-Ray run
+   (a stand-in that counts the pictures under TMPDIR, then runs POV-Ray) sees at most the
+   frame before's; kept, the fourth frame's would see three. */
+Test(animation, a_field_animations_pictures_go_frame_by_frame)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512], tmp_buf[512], script_buf[512], text[1024];
+    const char *scene = hold(scene_buf, dir, "scene.pov"), *tmp = hold(tmp_buf, dir, "tmp"),
+               *script = hold(script_buf, dir, "countpov");
+    write_text(scene, ANIMATED_SCENE);
+    cr_assert_eq(mkdir(tmp, 0755), 0);
+    snprintf(text, sizeof text, "#!/bin/sh\nfind '%s' -name '*.exr' | wc -l >> '%s/counts'\n"
+             "exec povray \"$@\"\n", tmp, dir);
+    write_text(script, text);
+    cr_assert_eq(chmod(script, 0755), 0);
+    setenv("LENS2POV_POVRAY", script, 1);
+    setenv("TMPDIR", tmp, 1);
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--sampling", "field",
+                       "--jobs", "1", "-q", "-o", tmp_path(dir, "f.png"), "--", "+KFI1", "+KFF4");
+    unsetenv("LENS2POV_POVRAY");
+    unsetenv("TMPDIR");
+    cr_assert_eq(st, 0, "render failed: %s", errtext ? errtext : "");
+    free(errtext);
+    for (int f = 1; f <= 4; f++) {
+        char name[32];
+        snprintf(name, sizeof name, "f%d.png", f);
+        cr_expect(file_exists(tmp_path(dir, name)), "no %s", name);
+    }
+    char *counts = read_text(tmp_path(dir, "counts"), NULL);
+    cr_assert_not_null(counts, "POV-Ray never ran");
+    int runs = 0, most = 0;
+    for (char *p = counts, *end; *p; p = end, runs++) {
+        const long n = strtol(p, &end, 10);
+        cr_assert(end != p, "counts: %s", counts);
+        most = n > most ? (int)n : most;
+        while (*end == '\n' || *end == ' ')
+            end++;
+    }
+    free(counts);
+    cr_expect_geq(runs, 4, "%d POV-Ray runs for four frames", runs);
+    cr_expect_leq(most, 1, "a POV-Ray run saw %d pictures in the work folder", most);
+}
+
 /* A table placed by a frame's transform gives the picture a table traced in place gives. In
    pixel sampling the animation's table is in three chunks (each rendered for every frame),
    the single frame's in one; in field sampling the two meshes are the same, moved by the

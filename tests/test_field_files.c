@@ -118,6 +118,40 @@ Test(field_files, developing_a_render_at_a_time_is_developing_all)
     free(a), free(b);
 }
 
+/* With remove_pictures, as render's own work folder has it, each picture goes once it is in
+   the sums and not before (a picture that came early waits for those before it), and the
+   picture is the one developing them all makes. */
+Test(field_files, a_developed_picture_goes_once_it_is_added)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *all = tmp_path(dir, "all.exr"), *each = tmp_path(dir, "each.exr");
+    const int renders = by_hand(dir, LENS_DIR "dgauss.50mm.dat", all);
+    cr_assert_geq(renders, 2, "one render shows no picture waiting");
+    field_map m;
+    l2p_error err;
+    cr_assert_eq(field_map_read(tmp_path(dir, "ft.map"), &m, &err), 0, "%s", err.text);
+    field_developer d;
+    cr_assert_eq(field_develop_start(&d, &m, &err), 0, "%s", err.text);
+    d.remove_pictures = true;
+    char path[64][1024];
+    cr_assert_leq(renders, 64);
+    for (int r = 0; r < renders; r++)
+        snprintf(path[r], sizeof path[r], "%s.f%03d.exr", tmp_path(dir, "ft"), r);
+    for (int r = renders - 1; r >= 0; r--) {
+        cr_assert_eq(field_develop_add(&d, r, path[r], &err), 0, "%s", err.text);
+        for (int q = r; q < renders; q++)
+            cr_expect_eq(file_exists(path[q]), r > 0, "render %d given: picture %d %s", r, q,
+                         r > 0 ? "gone before it was added" : "still there once added");
+    }
+    cr_assert_eq(field_develop_finish(&d, each, &err), 0, "%s", err.text);
+    field_develop_free(&d);
+    field_map_free(&m);
+    float *a = read_picture(all), *b = read_picture(each);
+    cr_expect(memcmp(a, b, sizeof *a * 4 * 40 * 30) == 0, "the pictures differ");
+    free(a), free(b);
+}
+
 /* develop refuses renders that do not belong to the map: too few, and one of another size,
    naming it; nothing is written. */
 Test(field_files, develop_refuses_renders_of_another_map)

@@ -218,6 +218,29 @@ Test(sizecheck, field_renders_are_estimated_at_their_own_size)
     }
 }
 
+/* A render's picture goes once it is developed, unless the work folder is kept or POV-Ray's own
+   options make each frame wait for all its renders: a 4000 x 3000 crop at 256 spp is one
+   sub-image a render of 4096 x 4096 pixels, and two processes hold about two of them each, not
+   all 256 (the field map's weights, a float a pixel and sample, stay in table_bytes). */
+Test(sizecheck, developed_field_pictures_are_not_counted_at_once)
+{
+    char *keep[] = {"s.pov", "dgauss.50mm", "--width", "4000", "--height", "3000", "--spp", "256",
+                    "--sampling", "field", "-o", "x.png", "--keep-temp", "w"};
+    char *povray[] = {"s.pov", "dgauss.50mm", "--width", "4000", "--height", "3000", "--spp", "256",
+                      "--sampling", "field", "-o", "x.png", "--", "+KFI1"};
+    const size_estimate gone = estimate_of(keep, 12, 2), kept = estimate_of(keep, 14, 2),
+                        frames = estimate_of(povray, 14, 2);
+    const double picture = 4096.0 * 4096.0 * SIZE_EXR_BYTES_PER_FACE;
+    const double state = 2 * 4096.0 * 4096.0 * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
+    cr_expect(gone.renders_bytes >= 4 * picture && gone.renders_bytes <= 4 * picture + state,
+              "%.0f bytes of renders, expected %.0f and the state files", gone.renders_bytes,
+              4 * picture);
+    cr_expect_geq(kept.renders_bytes, 256 * picture, "%.0f", kept.renders_bytes);
+    cr_expect_geq(frames.renders_bytes, 256 * picture, "%.0f", frames.renders_bytes);
+    cr_expect_eq(gone.table_bytes, kept.table_bytes);
+    cr_expect_geq(gone.table_bytes, 256 * 4000.0 * 3000.0 * sizeof(float));
+}
+
 /* POV-Ray keeps a .pov-state file beside a render in progress, 20 bytes a rendered pixel: a
    3000 x 2000 render at 1 spp (one process) needs its EXR and that file, 118 MB
    measured, which the estimate once left out, so that a disk passed the check and POV-Ray

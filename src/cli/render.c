@@ -202,7 +202,8 @@ static povray_chunk *chunk_list(const writer *w, int count, long long faces,
 /* The frames, each developed through the writer's sample map as soon as its chunks'
    pictures are in (povray_options' picture_done, on the calling thread) once the writer is
    done, since the map is complete only then: an animation stopped midway keeps the frames it
-   finished. Frames whose pictures came in before are developed at the end. */
+   finished. Frames whose pictures came in before are developed at the end. A developed
+   frame's pictures go, unless the work folder is kept. */
 typedef struct frames_developing {
     writer *w;
     const povray_chunk *pc;
@@ -212,6 +213,7 @@ typedef struct frames_developing {
     int *done;                 /* a frame's pictures in */
     bool *developed;
     const char **exrs;         /* a frame's pictures, one a chunk */
+    bool remove_pictures;      /* a frame's pictures are deleted once it is developed */
 } frames_developing;
 
 static int develop_frame(frames_developing *d, int f, int chunks, l2p_error *err)
@@ -227,6 +229,8 @@ static int develop_frame(frames_developing *d, int f, int chunks, l2p_error *err
         d->exrs[i] = d->pc[i * d->tf->count + f].output_exr;
     if (!st)
         st = develop_files(&d->map, d->exrs, chunks, d->tf->frame[f]->output, err);
+    for (int i = 0; !st && d->remove_pictures && i < chunks; i++)
+        unlink(d->exrs[i]);
     d->developed[f] = st == L2P_OK;
     return st;
 }
@@ -301,7 +305,7 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     const int chunk_jobs = (jobs + tf->count - 1) / tf->count;
     w.chunk_faces = chunk_faces_for(cam, c, chunk_jobs, &count);
     povray_chunk *pc = chunk_list(&w, count, w.chunk_faces, tf);
-    frames_developing d = {.w = &w, .pc = pc, .tf = tf};
+    frames_developing d = {.w = &w, .pc = pc, .tf = tf, .remove_pictures = !ws->keep};
     d.done = calloc((size_t)tf->count, sizeof *d.done);
     d.developed = calloc((size_t)tf->count, sizeof *d.developed);
     d.exrs = calloc((size_t)count + 1, sizeof *d.exrs);

@@ -127,8 +127,11 @@ static void field_memory(const field_layout *l, int jobs, size_estimate *e)
 }
 
 /* The workspace holds each render's include and ini (and POV-Ray's wrapper scene and log: at
-   most a render a sub-image), each sub-image's weights (a float a crop pixel) and each
-   render's EXR; --rays goes straight to its own folder. */
+   most a render a sub-image), each sub-image's weights (a float a crop pixel) and the renders'
+   EXRs; --rays goes straight to its own folder. A render's EXR goes once it is developed
+   (field_povray.c) unless the folder is kept: renders are developed in their order as they
+   come, so besides the one each POV-Ray process is writing, about one a process waits for
+   those before it. With POV-Ray's own options a frame's EXRs wait for the whole frame. */
 static size_estimate field_estimate(const cli *c, int jobs)
 {
     const field_layout l = field_layout_of(c, jobs);
@@ -137,7 +140,10 @@ static size_estimate field_estimate(const cli *c, int jobs)
                     l.spp * (SIZE_FIELD_RENDER_FILES_BYTES + l.pixels * sizeof(float));
     e.csv_bytes = c->rays_csv ? l.spp * l.pixels * SIZE_FIELD_CSV_BYTES_PER_ROW : 0.0;
     if (jobs > 0) {
-        e.renders_bytes = l.spp * l.subimage_pixels * SIZE_EXR_BYTES_PER_FACE +
+        const double all = l.spp * l.subimage_pixels;
+        const double pictures = c->keep_temp || c->povray_args ? all
+                                                               : fmin(all, 2 * l.at_once * l.render_pixels);
+        e.renders_bytes = pictures * SIZE_EXR_BYTES_PER_FACE +
                           l.at_once * l.render_pixels * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
         field_memory(&l, jobs, &e);
     }

@@ -4,6 +4,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "base/cleanup.h"
 #include "image/develop.h"
 #include "image/image_io.h"
@@ -115,6 +116,8 @@ static int add_known(field_developer *d, l2p_error *err)
         for (int i = 0; i < 2 && p[i].path; i++) {
             if (!st)
                 st = add_render(d->map, r + i, &p[i], d->weights, d->sums, err);
+            if (!st && d->remove_pictures)
+                unlink(p[i].path);
             free(p[i].rgba);
         }
         d->next += 1 + two;

@@ -3,6 +3,7 @@
 #ifndef LENS2POV_FIELD_FIELD_DEVELOP_H
 #define LENS2POV_FIELD_FIELD_DEVELOP_H
 
+#include <stdbool.h>
 #include "field/fieldmap.h"
 
 /* renders[r] is render r's picture (the ini's PREFIX.fNNN.exr), count of them; the picture goes
@@ -20,12 +21,14 @@ typedef struct field_developer {
     float *weights;
     char **picture;     /* render r's picture once given */
     int next;           /* the first render not yet added */
+    bool remove_pictures;   /* each picture is deleted once added (render's own, not kept) */
 } field_developer;
 
 int field_develop_start(field_developer *d, const field_map *m, l2p_error *err);
 
 /* Render r's picture is complete at path. L2P_FAILED for a render given twice; errors of
-   field_develop. */
+   field_develop. With remove_pictures set (after field_develop_start) the picture is deleted
+   once it is in the sums, so that a render's pictures on disk do not add up to spp of them. */
 int field_develop_add(field_developer *d, int r, const char *path, l2p_error *err);
 
 /* Writes the picture once every render has been added. */

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "field/field_develop.h"
 #include "field/field_files.h"
 #include "image/image_io.h"
@@ -89,6 +90,7 @@ static int render_by_jobs(const field_files *f, int jobs, const povray_options *
     developing d = {.f = f, .order = order};
     const bool have_map = !st && !(st = field_map_read(f->map_path, &m, err));
     const bool have_dev = have_map && !(st = field_develop_start(&d.dev, &m, err));
+    d.dev.remove_pictures = !po->work_dir_kept;
     povray_options with_pictures = *po;
     with_pictures.picture_done = picture_done;
     with_pictures.picture_ctx = &d;
@@ -147,14 +149,21 @@ typedef struct frames_developing {
     field_map map;
     int *done;                 /* a frame's renders in */
     const char **exr;          /* a frame's pictures, one a render */
+    bool remove_pictures;      /* a frame's pictures are deleted once it is developed */
 } frames_developing;
 
+/* Frame i's picture from its renders' pictures, which then go unless the work folder is kept:
+   an animation's renders would otherwise fill the disk frame by frame. */
 static int develop_frame(frames_developing *d, int i, l2p_error *err)
 {
     for (int r = 0; r < d->f->renders; r++)
         d->exr[r] = d->pc[i * d->f->renders + r].output_exr;
-    const int st = image_io_ready(err);
-    return st ? st : field_develop(&d->map, d->exr, d->f->renders, d->o->frames[i].output, err);
+    int st = image_io_ready(err);
+    if (!st)
+        st = field_develop(&d->map, d->exr, d->f->renders, d->o->frames[i].output, err);
+    for (int r = 0; r < d->f->renders && !st && d->remove_pictures; r++)
+        unlink(d->exr[r]);
+    return st;
 }
 
 static int frame_picture_done(void *ctx, int k, l2p_error *err)
@@ -168,7 +177,7 @@ static int frame_picture_done(void *ctx, int k, l2p_error *err)
 static int render_frames(const field_files *f, const povray_chunk *pc,
                          const field_render_options *o, const povray_options *po, l2p_error *err)
 {
-    frames_developing d = {.f = f, .pc = pc, .o = o};
+    frames_developing d = {.f = f, .pc = pc, .o = o, .remove_pictures = !po->work_dir_kept};
     int st = field_map_read(f->map_path, &d.map, err);
     if (st)
         return st;
