@@ -14,9 +14,12 @@ die() { say "$*"; exit 1; }
 now() { date +%s.%N; }
 
 # err_setup BUILD: $work, a temporary folder removed on exit; $bin, a private copy of BUILD's
-# lens2pov with its image library beside it (others may rebuild BUILD meanwhile); $version, their
-# hash (there is no --version: the binary changes with the code), which keys the cache; $cache,
-# with the references of other builds removed; $scene_key, the scene and camera's hash.
+# lens2pov with the libraries it looks for beside it (others may rebuild BUILD meanwhile): the
+# image library, and the one that shortens POV-Ray's polls, without which every POV-Ray run
+# idles between frames and a field render took a quarter longer than the user's; $version, the
+# hash of the first two (there is no --version: the binary changes with the code; the polls
+# change no pixel), which keys the cache; $cache, with the references of other builds removed;
+# $scene_key, the scene and camera's hash.
 err_setup() {
   [ -x "$1/lens2pov" ] || die "no $1/lens2pov: run make first"
   [ -r "$scene" ] || die "cannot read scene $scene"
@@ -24,7 +27,7 @@ err_setup() {
   mkdir -p "$cache"
   work=$(mktemp -d "$out/tmp.XXXXXX")
   trap 'rm -rf "$work"' EXIT
-  cp "$1/lens2pov" "$1/lens2pov-image-io.so" "$work/"
+  cp "$1/lens2pov" "$1/lens2pov-image-io.so" "$1/lens2pov-povray-polls.so" "$work/"
   bin=$work/lens2pov
   version=$(cat "$bin" "$work/lens2pov-image-io.so" | sha256sum | cut -c1-12)
   find "$cache" -name 'ref-*.exr' ! -name "*-$version.exr" -exec rm -f {} +
