@@ -17,9 +17,9 @@ now() { date +%s.%N; }
 # lens2pov with the libraries it looks for beside it (others may rebuild BUILD meanwhile): the
 # image library, and the one that shortens POV-Ray's polls, without which every POV-Ray run
 # idles between frames and a field render took a quarter longer than the user's; $version, the
-# hash of the first two (there is no --version: the binary changes with the code; the polls
-# change no pixel), which keys the cache; $cache, with the references of other builds removed;
-# $scene_key, the scene and camera's hash.
+# hash of lens2pov and the image library (there is no --version: the binary changes with the
+# code; the polls change no pixel), which keys the cache; $cache, with the references of other
+# builds removed; $scene_key, the scene and camera's hash.
 err_setup() {
   [ -x "$1/lens2pov" ] || die "no $1/lens2pov: run make first"
   [ -r "$scene" ] || die "cannot read scene $scene"
