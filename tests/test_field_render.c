@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "image/image_io.h"
 #include "support.h"
 
@@ -186,4 +187,81 @@ Test(field_render, packing_changes_no_pixel)
     cr_assert(w[0] == 50 && h[0] == 36 && w[1] == 50 && h[1] == 36);
     cr_expect(memcmp(px[0], px[1], sizeof(float) * 4 * 50 * 36) == 0, "the two packings differ");
     free(px[0]), free(px[1]);
+}
+
+/* The weights, a float a pixel and sub-image, never reach the disk unless the work folder is
+   kept: while POV-Ray runs (a stand-in lists the work folder first), it holds no field map.
+   The picture is the same, bit for bit, whether render keeps the weights in memory or makes
+   them again where the pixels pass (LENS2POV_FIELD_WEIGHTS_MB=0, as beyond
+   FIELD_WEIGHTS_KEPT_MB); kept, the folder's map holds every weight, and develop makes from
+   it and the kept renders the same picture again. */
+Test(field_render, the_weights_stay_off_the_disk_unless_the_work_folder_is_kept)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    char scene[1024], tmp[1024], keep[1024], script[1024], text[2048], out[3][1024], again[1024];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(tmp, sizeof tmp, "%s/tmp", dir);
+    snprintf(keep, sizeof keep, "%s/keep", dir);
+    snprintf(script, sizeof script, "%s/listpov", dir);
+    snprintf(again, sizeof again, "%s/again.exr", dir);
+    cr_assert_eq(mkdir(tmp, 0755), 0);
+    snprintf(text, sizeof text, "#!/bin/sh\nfind '%s' -name '*.map*' >> '%s/maps'\n"
+             "echo run >> '%s/runs'\nexec povray \"$@\"\n", tmp, dir, dir);
+    write_text(script, text);
+    cr_assert_eq(chmod(script, 0755), 0);
+    setenv("LENS2POV_POVRAY", script, 1);
+    setenv("TMPDIR", tmp, 1);
+    for (int kept = 0; kept < 3; kept++) {
+        snprintf(out[kept], sizeof out[kept], "%s/%s.exr", dir,
+                 kept == 2 ? "remade" : kept ? "kept" : "gone");
+        if (kept == 2)
+            setenv("LENS2POV_FIELD_WEIGHTS_MB", "0", 1);
+        char *errtext = NULL;
+        const int st = kept ? L2P(NULL, &errtext, "render", scene, LENS_DIR "fisheye.10mm.dat",
+                                  "--width", "48", "--height", "36", "--spp", "16", "--sampling",
+                                  "field", "--jobs", "1", "--quiet", "--keep-temp", keep, "-o",
+                                  out[kept])
+                            : L2P(NULL, &errtext, "render", scene, LENS_DIR "fisheye.10mm.dat",
+                                  "--width", "48", "--height", "36", "--spp", "16", "--sampling",
+                                  "field", "--jobs", "1", "--quiet", "-o", out[kept]);
+        cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+        free(errtext);
+        if (kept != 1) {
+            char *maps = read_text(tmp_path(dir, "maps"), NULL);
+            cr_assert(file_exists(tmp_path(dir, "runs")), "POV-Ray never ran");
+            cr_expect(!maps || !*maps, "the work folder held a map: %s", maps);
+            free(maps);
+        }
+    }
+    unsetenv("LENS2POV_POVRAY");
+    unsetenv("TMPDIR");
+    unsetenv("LENS2POV_FIELD_WEIGHTS_MB");
+    struct stat sb;
+    char map[1100];
+    snprintf(map, sizeof map, "%s/field.map", keep);
+    cr_assert_eq(stat(map, &sb), 0, "no %s", map);
+    cr_expect_geq(sb.st_size, 16 * 48 * 36 * 4, "%s: %lld bytes", map, (long long)sb.st_size);
+    char prefix[1100];
+    snprintf(prefix, sizeof prefix, "%s/field", keep);
+    char *errtext = NULL;
+    cr_assert_eq(L2P(NULL, &errtext, "develop", prefix, "-o", again), 0, "%s",
+                 errtext ? errtext : "");
+    free(errtext);
+    float *px[4];
+    int w, h;
+    l2p_error err;
+    const char *pictures[4] = {out[0], out[1], again, out[2]};
+    for (int i = 0; i < 4; i++) {
+        cr_assert_eq(image_read_rgba(pictures[i], &w, &h, &px[i], &err), 0, "%s", err.text);
+        cr_assert(w == 48 && h == 36);
+    }
+    cr_expect(memcmp(px[0], px[1], sizeof(float) * 4 * 48 * 36) == 0, "kept or not, the pictures differ");
+    cr_expect(memcmp(px[1], px[2], sizeof(float) * 4 * 48 * 36) == 0,
+              "develop of the kept folder differs from render's picture");
+    cr_expect(memcmp(px[0], px[3], sizeof(float) * 4 * 48 * 36) == 0,
+              "weights made again or kept, the pictures differ");
+    cr_expect_gt(mean(px[0]), 0.05, "the picture is black");
+    for (int i = 0; i < 4; i++)
+        free(px[i]);
 }

@@ -436,11 +436,9 @@ static void rays_from_batch(ray *r, const trace_batch *b, int n)
     }
 }
 
-void camera_trace_batch(const camera *c, sample_batch *s)
+void camera_film_rays(const camera *c, sample_batch *s, vec3 *direction)
 {
     const int n = s->n;
-    trace_batch b;
-    vec3 direction[CAMERA_BATCH];
     /* runs of samples drawn from one pupil (with dispersion, of wavelengths near one another) */
     for (int k = 0, end; k < n; k = end) {
         const pupil *pu = c->dispersion ? camera_pupil_at(c, s->wavelength_nm[k]) : &c->pupil;
@@ -449,11 +447,19 @@ void camera_trace_batch(const camera *c, sample_batch *s)
             end++;
         pupil_film_rays(pu, end - k, s->film_point + k, s->u + k, s->v + k, direction + k, s->weight + k);
     }
-    for (int k = 0; k < n; k++) {
+    for (int k = 0; k < n; k++)
         s->weight[k] *= c->weight_scale;
+}
+
+void camera_trace_batch(const camera *c, sample_batch *s)
+{
+    const int n = s->n;
+    trace_batch b;
+    vec3 direction[CAMERA_BATCH];
+    camera_film_rays(c, s, direction);
+    for (int k = 0; k < n; k++)
         b.status[k] = s->weight[k] > 0.0 && isfinite(s->weight[k]) && v3_isfinite(direction[k])
                           ? TRACE_PASSED : TRACE_MISSED;
-    }
     if (c->trace == TRACE_KIND_THICK) {
         for (int k = 0; k < n; k++) {
             s->out[k].o = s->film_point[k];

@@ -96,6 +96,11 @@ typedef struct sample_batch {
 
 void camera_trace_batch(const camera *c, sample_batch *b);
 
+/* camera_trace_batch's first step, without the lens: each sample's film ray toward its pupil
+   point (direction, CAMERA_BATCH of them) and its weight, 0 where the pupil gives none. What
+   the trace then gives those that pass, bit for bit. */
+void camera_film_rays(const camera *c, sample_batch *b, vec3 *direction);
+
 /* Camera space (mm) to world (scene units): a point; a difference of points (the rotation and
    the scale without the translation); a direction, normalized. */
 vec3 camera_world_from_camera_point(const camera *c, vec3 p);

@@ -64,6 +64,7 @@ static size_estimate pixel_estimate(const cli *c, int jobs)
    bounds of what a render holds whatever the faces turn out to be. */
 typedef struct field_layout {
     double pixels, spp;
+    double rows;               /* the crop's */
     double subimage_faces;     /* a sub-image's faces, estimated */
     double subimage_pixels;    /* a sub-image's render, had it one of its own */
     double render_faces;       /* a render's faces, at most */
@@ -93,7 +94,7 @@ static field_layout field_layout_of(const cli *c, int jobs)
 {
     int w, h;
     crop_size(&c->cam, &w, &h);
-    field_layout l = {.pixels = (double)w * h, .spp = c->cam.spp};
+    field_layout l = {.pixels = (double)w * h, .spp = c->cam.spp, .rows = h};
     const double cells = ceil((w - 1.0) / FIELD_COARSEST_CELL) * ceil((h - 1.0) / FIELD_COARSEST_CELL);
     const double coarsest = fmax(1.0, 2.0 * cells);
     const double most = ceil(l.spp / (jobs > 0 ? jobs : 1));
@@ -108,13 +109,18 @@ static field_layout field_layout_of(const cli *c, int jobs)
 
 /* lens2pov keeps every sub-image's mesh until the renders are written: a face (field_mesh's
    tri) and a vertex (pos, nrm, pix, uv) a face, a margin over the half as many vertices as
-   faces of a triangulated grid, and SIZE_FIELD_BYTES_PER_SUBIMAGE. Meanwhile it
-   builds on jobs threads (a crop pixel's ray, weight, flags, prefix sum and vertex index,
-   subimage.c), waits for POV-Ray's processes, then develops (the sums, a sub-image's
-   weights, a render's picture as float RGBA). */
+   faces of a triangulated grid, and SIZE_FIELD_BYTES_PER_SUBIMAGE; and until it is developed,
+   its weights (fieldpass.h): a float a pixel while all of them fit FIELD_WEIGHTS_KEPT_MB,
+   else where its pixels pass, four runs a row of the crop (more only with more faces).
+   Meanwhile it builds on jobs threads (a crop pixel's ray, weight, flags, prefix sum and
+   vertex index, subimage.c), waits for POV-Ray's processes, then develops (the sums, a
+   sub-image's weights, a render's picture as float RGBA). */
 static void field_memory(const field_layout *l, int jobs, size_estimate *e)
 {
     const double mesh_face = 3 * sizeof(int) + 6 * sizeof(float) + 4 * sizeof(double);
+    const double weights = l->spp * l->pixels * sizeof(float);
+    const double runs = l->spp * 4 * l->rows * 2 * sizeof(long long);
+    const double kept = weights <= FIELD_WEIGHTS_KEPT_MB * 1048576.0 ? weights : runs;
     const double meshes = l->spp * (l->subimage_faces * mesh_face + SIZE_FIELD_BYTES_PER_SUBIMAGE);
     const double build = jobs * l->pixels * (sizeof(ray) + sizeof(float) + 2 + 2 * sizeof(int));
     e->povray_process_bytes = POVRAY_BASE_BYTES +
@@ -123,12 +129,13 @@ static void field_memory(const field_layout *l, int jobs, size_estimate *e)
     const double povray = l->at_once * e->povray_process_bytes;
     const double develop = l->pixels * (DEVELOP_BYTES_PER_PIXEL + sizeof(float)) +
                            l->render_pixels * 4 * sizeof(float);
-    e->memory_bytes = meshes + fmax(build, fmax(povray, develop));
+    e->memory_bytes = meshes + kept + fmax(build, fmax(povray, develop));
 }
 
 /* The workspace holds each render's include and ini (and POV-Ray's wrapper scene and log: at
-   most a render a sub-image), each sub-image's weights (a float a crop pixel) and the renders'
-   EXRs; --rays goes straight to its own folder. A render's EXR goes once it is developed
+   most a render a sub-image) and the renders' EXRs; trace's map, and render's when the folder
+   is kept, each sub-image's weights (a float a crop pixel; render makes them again where the
+   pixels pass, fieldpass.h); --rays goes straight to its own folder. A render's EXR goes once it is developed
    (field_povray.c) unless the folder is kept: renders are developed in their order as they
    come, so besides the one each POV-Ray process is writing, about one a process waits for
    those before it. With POV-Ray's own options a frame's EXRs wait for the whole frame. */
@@ -136,8 +143,10 @@ static size_estimate field_estimate(const cli *c, int jobs)
 {
     const field_layout l = field_layout_of(c, jobs);
     size_estimate e = {.faces = l.spp * l.subimage_faces};
+    const bool weights_on_disk = jobs == 0 || c->keep_temp;
     e.table_bytes = e.faces * SIZE_FIELD_INCLUDE_BYTES_PER_FACE +
-                    l.spp * (SIZE_FIELD_RENDER_FILES_BYTES + l.pixels * sizeof(float));
+                    l.spp * (SIZE_FIELD_RENDER_FILES_BYTES +
+                             (weights_on_disk ? l.pixels * sizeof(float) : 0.0));
     e.csv_bytes = c->rays_csv ? l.spp * l.pixels * SIZE_FIELD_CSV_BYTES_PER_ROW : 0.0;
     if (jobs > 0) {
         const double all = l.spp * l.subimage_pixels;

@@ -41,7 +41,8 @@
 
 typedef struct size_estimate {
     double faces;                 /* at most (field sampling: estimated) */
-    double table_bytes;           /* include, ini and sample map; field: includes, inis, weights */
+    double table_bytes;           /* include, ini and sample map; field: includes, inis, and the
+                                     map's weights where written (trace, render's kept folder) */
     double csv_bytes;             /* --rays, 0 without */
     double renders_bytes;         /* render: the chunks' (field: the renders') EXR files, and
                                      POV-Ray's state files of the renders at once */

@@ -6,6 +6,8 @@
 
 #include "base/outfile.h"
 #include "camera/camera.h"
+#include "field/fieldmap.h"
+#include "field/fieldpass.h"
 #include "field/field_render.h"
 #include "povray/povray.h"
 
@@ -19,8 +21,12 @@ typedef struct field_render_plan {
 
 /* The outputs, under temporary names until committed. */
 typedef struct field_files {
-    outfile map;
-    char *map_path;            /* the map's final path (outfile forgets it once committed) */
+    outfile map;               /* the map's file, with its weights, when asked for */
+    char *map_path;            /* its final path (outfile forgets it once committed); NULL:
+                                  none */
+    field_map table;           /* the map in memory, its weights from pass */
+    field_pass *pass;          /* each sub-image's weights, kept or to be made again */
+    const camera *camera;      /* what they are made again with */
     outfile *inc, *ini;
     povray_chunk *chunk;       /* render r's include, ini and picture paths, faces */
     field_render_plan *plans;
@@ -41,6 +47,12 @@ typedef struct field_files_request {
     /* What a render costs POV-Ray beyond its pixels, as a frame of a run (seconds): what the
        packing weighs against the face search (field_render.c, cost_per_sub). */
     double frame_s;
+    /* Whether PREFIX.map is written with every sub-image's weights (trace's, and render's
+       when its work folder is kept, for develop); render itself develops from the table. */
+    bool map_file;
+    /* The most bytes of weights kept in memory for render's develop; beyond, they are made
+       again where the pixels pass (fieldpass.h). */
+    double weights_kept_bytes;
 } field_files_request;
 
 /* That cost as POV-Ray is, and as lens2pov runs it, its polls shortened (povray_env.h): the
@@ -48,8 +60,8 @@ typedef struct field_files_request {
 #define FIELD_FRAME_S 0.25
 #define FIELD_FRAME_POLLS_S 0.04
 
-/* Builds the sub-images and writes the map, every render's include and ini and the CSV, then
-   commits all but the CSV. L2P_BAD_INPUT naming --sampling pixel for a tolerance not above 0
+/* Builds the sub-images and writes the map (when asked for), every render's include and ini
+   and the CSV, then commits all but the CSV. L2P_BAD_INPUT naming --sampling pixel for a tolerance not above 0
    or a sub-image that would need more faces than pixels. *out is always set; free it with
    field_files_free, which removes what was not committed. */
 int field_files_make(const camera *c, const field_files_request *q, field_files *out,

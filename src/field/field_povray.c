@@ -86,10 +86,8 @@ static int render_by_jobs(const field_files *f, int jobs, const povray_options *
     int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int k = 0; k < f->renders && !st; k++)
         by_job[k] = f->chunk[order[k]];
-    field_map m;
     developing d = {.f = f, .order = order};
-    const bool have_map = !st && !(st = field_map_read(f->map_path, &m, err));
-    const bool have_dev = have_map && !(st = field_develop_start(&d.dev, &m, err));
+    const bool have_dev = !st && !(st = field_develop_start(&d.dev, &f->table, err));
     d.dev.remove_pictures = !po->work_dir_kept;
     povray_options with_pictures = *po;
     with_pictures.picture_done = picture_done;
@@ -100,8 +98,6 @@ static int render_by_jobs(const field_files *f, int jobs, const povray_options *
         st = field_develop_finish(&d.dev, out, err);
     if (have_dev)
         field_develop_free(&d.dev);
-    if (have_map)
-        field_map_free(&m);
     free(by_job), free(order), free(frames);
     return st;
 }
@@ -146,7 +142,6 @@ typedef struct frames_developing {
     const field_files *f;
     const povray_chunk *pc;
     const field_render_options *o;
-    field_map map;
     int *done;                 /* a frame's renders in */
     const char **exr;          /* a frame's pictures, one a render */
     bool remove_pictures;      /* a frame's pictures are deleted once it is developed */
@@ -160,7 +155,7 @@ static int develop_frame(frames_developing *d, int i, l2p_error *err)
         d->exr[r] = d->pc[i * d->f->renders + r].output_exr;
     int st = image_io_ready(err);
     if (!st)
-        st = field_develop(&d->map, d->exr, d->f->renders, d->o->frames[i].output, err);
+        st = field_develop(&d->f->table, d->exr, d->f->renders, d->o->frames[i].output, err);
     for (int r = 0; r < d->f->renders && !st && d->remove_pictures; r++)
         unlink(d->exr[r]);
     return st;
@@ -178,9 +173,7 @@ static int render_frames(const field_files *f, const povray_chunk *pc,
                          const field_render_options *o, const povray_options *po, l2p_error *err)
 {
     frames_developing d = {.f = f, .pc = pc, .o = o, .remove_pictures = !po->work_dir_kept};
-    int st = field_map_read(f->map_path, &d.map, err);
-    if (st)
-        return st;
+    int st = L2P_OK;
     d.done = calloc((size_t)o->frame_count, sizeof *d.done);
     d.exr = malloc(sizeof *d.exr * ((size_t)f->renders + 1));
     if (!d.done || !d.exr)
@@ -192,8 +185,16 @@ static int render_frames(const field_files *f, const povray_chunk *pc,
         st = povray_render_chunks(pc, f->renders * o->frame_count, &with_frames, err);
     free(d.done);
     free(d.exr);
-    field_map_free(&d.map);
     return st;
+}
+
+/* FIELD_WEIGHTS_KEPT_MB, or the environment's (field_render.h), in bytes. */
+static double weights_kept_bytes(void)
+{
+    const char *text = getenv("LENS2POV_FIELD_WEIGHTS_MB");
+    char *end = NULL;
+    const double mb = text && *text ? strtod(text, &end) : -1.0;
+    return (end && !*end && mb >= 0.0 ? mb : FIELD_WEIGHTS_KEPT_MB) * 1048576.0;
 }
 
 int field_render(const camera *c, const field_render_options *o, l2p_error *err)
@@ -203,7 +204,8 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                    o->frames[0].placement ? "Lens2pov_Placement" : NULL,
                                    o->rays_csv,
                                    povray_polls_library(library, sizeof library)
-                                       ? FIELD_FRAME_POLLS_S : FIELD_FRAME_S};
+                                       ? FIELD_FRAME_POLLS_S : FIELD_FRAME_S,
+                                   o->work_dir_kept, weights_kept_bytes()};
     field_files f;
     int st = field_files_make(c, &q, &f, err);
     if (o->too_fine)

@@ -1,6 +1,8 @@
 /* The files of render and trace --sampling field: sub-images built on worker threads, their
-   weights into the field map, packed into POV-Ray renders of at most FIELD_FACES_PER_RENDER
-   faces, each render's include and ini (field_povray.c runs and develops them). */
+   weights into the field map's file (trace's, and render's kept work folder's) and kept for
+   render's develop (fieldpass.h), packed into POV-Ray renders of at most
+   FIELD_FACES_PER_RENDER faces, each render's include and ini (field_povray.c runs and
+   develops them). */
 #include "field/field_files.h"
 
 #include <pthread.h>
@@ -9,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "field/fieldmap.h"
+#include "field/fieldpass.h"
 #include "field/fieldrays.h"
 #include "field/strata.h"
 #include "field/subimage.h"
@@ -19,7 +22,8 @@
 
 typedef struct sub {
     field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
-    float *weights;            /* one a crop pixel, while building; then in the map */
+    float *weights;            /* one a crop pixel, while building; then in the map's file and
+                                  kept (field_pass) */
     uint32_t band;             /* its wavelength band, with dispersion */
     field_stats stats;
     field_placement at;        /* where it is rendered */
@@ -27,8 +31,11 @@ typedef struct sub {
 
 typedef struct job {
     const camera *c;
-    const outfile *map;        /* the field map, its weights written as sub-images are built */
+    const outfile *map;        /* the field map, its weights written as sub-images are built;
+                                  NULL: no file */
     const samplemap_header *header;
+    field_pass *pass;          /* each sub-image's weights as kept until developed */
+    bool keep_weights;         /* the weights themselves, not their runs */
     const field_tolerance *tol;
     field_strata strata;
     sub *subs;
@@ -76,11 +83,13 @@ static void *build_worker(void *arg)
                           "use a larger tolerance or --sampling pixel", j->tol->pixels,
                           s->stats.faces, pixels, k);
         const bool too_fine = st == L2P_BAD_INPUT;   /* the two refusals above */
-        if (!st) {
+        if (!st)
             field_mesh_shrink(&s->mesh);   /* kept until the renders are written */
-            /* into the map now: spp of them in memory would be spp pictures */
+        if (!st && j->map)
             st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
-        }
+        if (!st)
+            st = field_pass_of(&s->weights, (long long)pixels, shared, scale, j->keep_weights,
+                               &j->pass[k], &e);
         free(s->weights);
         s->weights = NULL;
         if (st) {
@@ -368,26 +377,34 @@ static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l
     return st ? st : outfile_finish(csv, err);
 }
 
-/* The map's tables: each render's size, each sub-image's place and band. */
+/* Sub-image k's weights for f's map (its weights_of), as kept. */
+static int weights_again(const void *ctx, int k, float *weights, l2p_error *err)
+{
+    const field_files *f = ctx;
+    return field_pass_weights(f->camera, &f->pass[k], weights, err);
+}
+
+/* The map's tables: each render's size, each sub-image's place and band; into the file too
+   when there is one. */
 static int finish_map(const camera *c, const sub *subs, const field_render_plan *plans, int renders,
-                      const outfile *f, l2p_error *err)
+                      field_files *f, l2p_error *err)
 {
     const int spp = c->samples.spp;
-    field_map m = {.renders = renders};
-    povmesh_camera_header(c, &m.header);
-    m.width = malloc(sizeof *m.width * (size_t)renders);
-    m.height = malloc(sizeof *m.height * (size_t)renders);
-    m.at = malloc(sizeof *m.at * (size_t)spp);
-    m.band = malloc(sizeof *m.band * (size_t)spp);
-    int st = m.width && m.height && m.at && m.band ? L2P_OK
+    field_map *m = &f->table;
+    *m = (field_map){.renders = renders, .weights_of = weights_again, .weights_ctx = f};
+    povmesh_camera_header(c, &m->header);
+    m->width = malloc(sizeof *m->width * (size_t)renders);
+    m->height = malloc(sizeof *m->height * (size_t)renders);
+    m->at = malloc(sizeof *m->at * (size_t)spp);
+    m->band = malloc(sizeof *m->band * (size_t)spp);
+    int st = m->width && m->height && m->at && m->band ? L2P_OK
              : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int r = 0; !st && r < renders; r++)
-        m.width[r] = plans[r].width, m.height[r] = plans[r].height;
+        m->width[r] = plans[r].width, m->height[r] = plans[r].height;
     for (int k = 0; !st && k < spp; k++)
-        m.at[k] = subs[k].at, m.band[k] = subs[k].band;
-    if (!st)
-        st = field_map_finish(f, &m, err);
-    field_map_free(&m);
+        m->at[k] = subs[k].at, m->band[k] = subs[k].band;
+    if (!st && f->map_path)
+        st = field_map_finish(&f->map, m, err);
     return st;
 }
 
@@ -396,6 +413,10 @@ static int finish_map(const camera *c, const sub *subs, const field_render_plan 
 void field_files_free(field_files *f)
 {
     outfile_discard(&f->map);
+    field_map_free(&f->table);
+    for (int k = 0; f->pass && k < f->camera->samples.spp; k++)
+        field_pass_free(&f->pass[k]);
+    free(f->pass);
     for (int r = 0; r < f->renders; r++) {
         outfile_discard(&f->inc[r]), outfile_discard(&f->ini[r]);
         free((char *)f->chunk[r].include_path), free((char *)f->chunk[r].ini_path);
@@ -407,15 +428,15 @@ void field_files_free(field_files *f)
 
 static int files_commit(field_files *f, l2p_error *err)
 {
-    int st = outfile_commit(&f->map, err);
+    int st = f->map_path ? outfile_commit(&f->map, err) : L2P_OK;
     for (int r = 0; r < f->renders && !st; r++)
         if (!(st = outfile_commit(&f->inc[r], err)))
             st = outfile_commit(&f->ini[r], err);
     return st;
 }
 
-/* Builds the sub-images (weights into the map), packs them and writes every render's include
-   and ini and the map's tables, under temporary names. */
+/* Builds the sub-images (weights into the map's file, if any, and kept in out), packs them and writes every render's include and ini and the map, under temporary
+   names. */
 static int build_files(const camera *c, const field_files_request *q, field_files *out,
                        sub **subs_out, l2p_error *err)
 {
@@ -432,21 +453,26 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     povmesh_camera_header(c, &header);
     sub *subs = calloc((size_t)spp, sizeof *subs);
     field_render_plan *plans = calloc((size_t)spp, sizeof *plans);
-    char *map_path = malloc(strlen(prefix) + 8);
-    memset(out, 0, sizeof *out);
+    char *map_path = q->map_file ? malloc(strlen(prefix) + 8) : NULL;
+    out->camera = c;
+    out->pass = calloc((size_t)spp, sizeof *out->pass);
     *subs_out = subs;
-    if (!subs || !plans || !map_path) {
+    if (!subs || !plans || !out->pass || (q->map_file && !map_path)) {
         free(plans), free(map_path);
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
     for (int k = 0; k < spp; k++)
         field_mesh_init(&subs[k].mesh, field_render_size(w), field_render_size(h));
-    sprintf(map_path, "%s.map", prefix);
-    out->map_path = map_path;
-    int st = outfile_open(&out->map, map_path, err);
-    if (!st)
-        st = field_map_begin(&out->map, &header, err);
-    job j = {.c = c, .map = &out->map, .header = &header, .tol = &tol, .subs = subs, .spp = spp};
+    int st = L2P_OK;
+    if (map_path) {
+        sprintf(map_path, "%s.map", prefix);
+        out->map_path = map_path;
+        if (!(st = outfile_open(&out->map, map_path, err)))
+            st = field_map_begin(&out->map, &header, err);
+    }
+    job j = {.c = c, .map = map_path ? &out->map : NULL, .header = &header, .pass = out->pass,
+             .keep_weights = 4.0 * spp * w * h <= q->weights_kept_bytes, .tol = &tol,
+             .subs = subs, .spp = spp};
     field_strata_count(c, &j.strata);
     atomic_init(&j.next, 0);
     atomic_init(&j.status, L2P_OK);
@@ -457,7 +483,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     pthread_mutex_destroy(&j.lock);
     const int renders = st ? 0 : pack(subs, spp, w, h, jobs, q->frame_s, plans);
     if (!st)
-        st = finish_map(c, subs, plans, renders, &out->map, err);
+        st = finish_map(c, subs, plans, renders, out, err);
     if (!st)
         st = outfile_finish(&out->map, err);
     out->inc = calloc((size_t)renders + 1, sizeof *out->inc);
@@ -495,6 +521,7 @@ int field_files_make(const camera *c, const field_files_request *q, field_files 
                      l2p_error *err)
 {
     sub *subs = NULL;
+    memset(out, 0, sizeof *out);   /* also when build_files refuses the tolerance first */
     int st = build_files(c, q, out, &subs, err);
     if (!st && q->rays_csv)
         st = write_rays(c, subs, c->samples.spp, q->rays_csv, err);
@@ -515,7 +542,7 @@ int field_trace(const camera *c, const field_trace_options *o, field_trace_stats
 {
     /* the renders are for the user's POV-Ray, whose polls are as they are */
     const field_files_request q = {o->prefix, o->jobs, o->tolerance_px, NULL, o->rays_csv,
-                                   FIELD_FRAME_S};
+                                   FIELD_FRAME_S, true, 0};
     field_files f;
     const int st = field_files_make(c, &q, &f, err);
     *stats = f.stats;

@@ -247,6 +247,8 @@ int field_map_read(const char *path, field_map *out, l2p_error *err)
 
 int field_map_weights(const field_map *m, int k, float *weights, l2p_error *err)
 {
+    if (m->weights_of)
+        return m->weights_of(m->weights_ctx, k, weights, err);
     const size_t n = (size_t)crop_pixels(&m->header);
     unsigned char *bytes = malloc(4 * n);
     const int fd = open_file(m->path);

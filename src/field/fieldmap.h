@@ -1,6 +1,7 @@
 /* The field map: what developing a field render needs, on disk (PREFIX.map of trace
-   --sampling field; WORK/field.map of render --sampling field), so that `develop` takes the
-   renders of either.
+   --sampling field; WORK/field.map of render --sampling field when --keep-temp keeps its
+   work folder), so that `develop` takes the renders of either. render itself develops from
+   the same map in memory, its weights kept apart (weights_of).
 
    File layout: a text header of SAMPLEMAP_HEADER_BYTES bytes, as the sample map's
    (samplemap.h) but with the first line "lens2pov-fieldmap 1", its face layout keys 0, and the
@@ -28,6 +29,10 @@ typedef struct field_map {
     field_placement *at;       /* each sub-image's render and place */
     uint32_t *band;            /* each sub-image's wavelength band (0 without dispersion) */
     char *path;                /* where the weights are read from */
+    /* Or, for render's map, whose weights are never written: what makes sub-image k's
+       (field_render.c, from fieldpass.h); NULL: read from path. */
+    int (*weights_of)(const void *ctx, int k, float *weights, l2p_error *err);
+    const void *weights_ctx;
 } field_map;
 
 /* Writing, in three steps: begin leaves room for the header and the weights (the file must be
@@ -45,7 +50,7 @@ int field_map_is_one(const char *path);
 
 int field_map_read(const char *path, field_map *out, l2p_error *err);
 
-/* Sub-image k's weights (crop width x crop height floats), checked. */
+/* Sub-image k's weights (crop width x crop height floats), checked when read from the file. */
 int field_map_weights(const field_map *m, int k, float *weights, l2p_error *err);
 
 void field_map_free(field_map *m);

@@ -71,8 +71,8 @@ film_sample field_shared_sample(const camera *c, int k, uint32_t *band)
     return s;
 }
 
-void field_trace_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
-                        sample_batch *batch)
+/* The film samples of crop pixels first .. first + n - 1 seen with shared sample s. */
+static void pixel_samples(const camera *c, film_sample s, long first, int n, sample_batch *batch)
 {
     batch->n = n;
     for (int k = 0; k < n; k++) {
@@ -83,6 +83,22 @@ void field_trace_pixels(const camera *c, film_sample s, double weight_scale, lon
         batch->v[k] = s.pupil_v;
         batch->wavelength_nm[k] = s.wavelength_nm;
     }
+}
+
+void field_weigh_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
+                        sample_batch *batch)
+{
+    vec3 direction[CAMERA_BATCH];
+    pixel_samples(c, s, first, n, batch);
+    camera_film_rays(c, batch, direction);
+    for (int k = 0; k < n; k++)
+        batch->weight[k] *= weight_scale;
+}
+
+void field_trace_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
+                        sample_batch *batch)
+{
+    pixel_samples(c, s, first, n, batch);
     camera_trace_batch(c, batch);
     for (int k = 0; k < n; k++) {
         const ray *r = &batch->out[k];

@@ -69,6 +69,12 @@ void field_pixel_raster(const camera *c, film_sample s, long i, double *rx, doub
 void field_trace_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
                         sample_batch *b);
 
+/* The weights alone of the same pixels (b's film points and weights), as field_trace_pixels
+   gives them to those that pass, bit for bit, without tracing the lens: a render develops its
+   sub-images with weights made again where they pass (fieldpass.h) instead of keeping them. */
+void field_weigh_pixels(const camera *c, film_sample s, double weight_scale, long first, int n,
+                        sample_batch *b);
+
 /* Sub-image k's shared sample: point k of the Owen-scrambled Sobol set; with dispersion also
    its wavelength, the bands dealt to the sub-images as pixel sampling deals them to a pixel's
    samples (sample_pattern_wavelength), and *band (when not NULL) gets its band, 0 without.

@@ -1,0 +1,34 @@
+/* A sub-image's weights as render keeps them until developed: the weights themselves while
+   they take little memory, else only where the pixels pass, as runs, from which they are made
+   again. All of them kept would be spp x pixels floats; the runs grow with the edges of the
+   region the lens passes, as the sub-image's faces do, and making the weights again takes
+   the pupil alone, without the lens trace. Either way, nothing of them goes to disk. */
+#ifndef LENS2POV_FIELD_FIELDPASS_H
+#define LENS2POV_FIELD_FIELDPASS_H
+
+#include <stdbool.h>
+#include "base/error.h"
+#include "camera/camera.h"
+
+typedef struct field_pass {
+    float *weights;            /* kept as built, one a crop pixel; NULL: made again */
+    film_sample sample;        /* the sub-image's shared sample, placed in its stratum */
+    double weight_scale;       /* its stratum's (field_strata_place) */
+    long long *runs;           /* begin, end (exclusive) of each run of passing crop pixels,
+                                  pixel y * crop width + x, increasing */
+    long long run_count;
+} field_pass;
+
+/* From the weights field_build_subimage gave a sub-image (those above 0 pass), seen with s and
+   weight_scale: with keep, *weights itself, which out then owns (*weights becomes NULL); else
+   the runs. L2P_FAILED out of memory. */
+int field_pass_of(float **weights, long long pixels, film_sample s, double weight_scale,
+                  bool keep, field_pass *out, l2p_error *err);
+
+/* The weights again, one a crop pixel of camera c: those field_build_subimage gave, bit for
+   bit, where the pixels pass, 0 elsewhere. L2P_FAILED out of memory. */
+int field_pass_weights(const camera *c, const field_pass *p, float *weights, l2p_error *err);
+
+void field_pass_free(field_pass *p);
+
+#endif
