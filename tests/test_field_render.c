@@ -256,7 +256,8 @@ Test(field_render, the_weights_stay_off_the_disk_unless_the_work_folder_is_kept)
         cr_assert_eq(image_read_rgba(pictures[i], &w, &h, &px[i], &err), 0, "%s", err.text);
         cr_assert(w == 48 && h == 36);
     }
-    cr_expect(memcmp(px[0], px[1], sizeof(float) * 4 * 48 * 36) == 0, "kept or not, the pictures differ");
+    cr_expect(memcmp(px[0], px[1], sizeof(float) * 4 * 48 * 36) == 0,
+              "kept or not, the pictures differ");
     cr_expect(memcmp(px[1], px[2], sizeof(float) * 4 * 48 * 36) == 0,
               "develop of the kept folder differs from render's picture");
     cr_expect(memcmp(px[0], px[3], sizeof(float) * 4 * 48 * 36) == 0,
@@ -264,4 +265,25 @@ Test(field_render, the_weights_stay_off_the_disk_unless_the_work_folder_is_kept)
     cr_expect_gt(mean(px[0]), 0.05, "the picture is black");
     for (int i = 0; i < 4; i++)
         free(px[i]);
+}
+
+/* LENS2POV_FIELD_WEIGHTS_MB that is not a number of MB, 0 or more, is refused, naming it. */
+Test(field_render, a_bad_weights_bound_in_the_environment_is_refused)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *bad[] = {"", "abc", "-1", "12MB", "nan"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        setenv("LENS2POV_FIELD_WEIGHTS_MB", bad[i], 1);
+        char *errtext = NULL;
+        const int st = L2P(NULL, &errtext, "render", tmp_path(dir, "scene.pov"),
+                           LENS_DIR "dgauss.50mm.dat", "--width", "48", "--height", "36", "--spp",
+                           "4", "--sampling", "field", "--quiet", "-o", tmp_path(dir, "x.png"));
+        unsetenv("LENS2POV_FIELD_WEIGHTS_MB");
+        cr_expect_eq(st, 2, "'%s': exit %d", bad[i], st);
+        cr_expect(errtext && strstr(errtext, "LENS2POV_FIELD_WEIGHTS_MB"), "'%s': %s", bad[i],
+                  errtext ? errtext : "(nothing)");
+        cr_expect(!file_exists(tmp_path(dir, "x.png")), "'%s': a picture was written", bad[i]);
+        free(errtext);
+    }
 }

@@ -134,11 +134,11 @@ static void field_memory(const field_layout *l, int jobs, size_estimate *e)
 
 /* The workspace holds each render's include and ini (and POV-Ray's wrapper scene and log: at
    most a render a sub-image) and the renders' EXRs; trace's map, and render's when the folder
-   is kept, each sub-image's weights (a float a crop pixel; render makes them again where the
-   pixels pass, fieldpass.h); --rays goes straight to its own folder. A render's EXR goes once it is developed
-   (field_povray.c) unless the folder is kept: renders are developed in their order as they
-   come, so besides the one each POV-Ray process is writing, about one a process waits for
-   those before it. With POV-Ray's own options a frame's EXRs wait for the whole frame. */
+   is kept, each sub-image's weights (a float a crop pixel; render keeps them off the disk,
+   fieldpass.h); --rays goes straight to its own folder. A render's EXR goes once it is
+   developed (field_povray.c) unless the folder is kept: renders are developed in their order
+   as they come, so besides the one each POV-Ray process is writing, about one a process waits
+   for those before it. With POV-Ray's own options a frame's EXRs wait for the whole frame. */
 static size_estimate field_estimate(const cli *c, int jobs)
 {
     const field_layout l = field_layout_of(c, jobs);

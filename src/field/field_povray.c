@@ -6,6 +6,7 @@
 #include "field/field_render.h"
 
 #include <limits.h>
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -188,24 +189,33 @@ static int render_frames(const field_files *f, const povray_chunk *pc,
     return st;
 }
 
-/* FIELD_WEIGHTS_KEPT_MB, or the environment's (field_render.h), in bytes. */
-static double weights_kept_bytes(void)
+/* FIELD_WEIGHTS_KEPT_MB, or the environment's (field_render.h), in bytes; L2P_BAD_INPUT for a
+   value that is not a number of 0 or more. */
+static int weights_kept_bytes(double *bytes, l2p_error *err)
 {
-    const char *text = getenv("LENS2POV_FIELD_WEIGHTS_MB");
+    static const char name[] = "LENS2POV_FIELD_WEIGHTS_MB";
+    const char *text = getenv(name);
     char *end = NULL;
-    const double mb = text && *text ? strtod(text, &end) : -1.0;
-    return (end && !*end && mb >= 0.0 ? mb : FIELD_WEIGHTS_KEPT_MB) * 1048576.0;
+    const double mb = text ? strtod(text, &end) : FIELD_WEIGHTS_KEPT_MB;
+    if (text && (end == text || *end || !(mb >= 0.0) || !isfinite(mb)))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s in the environment is '%s', not a "
+                        "number of MB, 0 or more", name, text);
+    *bytes = mb * 1048576.0;
+    return L2P_OK;
 }
 
 int field_render(const camera *c, const field_render_options *o, l2p_error *err)
 {
+    double weights_bytes = 0.0;
+    if (weights_kept_bytes(&weights_bytes, err))
+        return L2P_BAD_INPUT;
     char library[PATH_MAX + 64];
     const field_files_request q = {o->prefix, o->jobs, o->tolerance_px,
                                    o->frames[0].placement ? "Lens2pov_Placement" : NULL,
                                    o->rays_csv,
                                    povray_polls_library(library, sizeof library)
                                        ? FIELD_FRAME_POLLS_S : FIELD_FRAME_S,
-                                   o->work_dir_kept, weights_kept_bytes()};
+                                   o->work_dir_kept, weights_bytes};
     field_files f;
     int st = field_files_make(c, &q, &f, err);
     if (o->too_fine)

@@ -435,8 +435,8 @@ static int files_commit(field_files *f, l2p_error *err)
     return st;
 }
 
-/* Builds the sub-images (weights into the map's file, if any, and kept in out), packs them and writes every render's include and ini and the map, under temporary
-   names. */
+/* Builds the sub-images (weights into the map's file, if any, and kept in out), packs them
+   and writes every render's include and ini and the map, under temporary names. */
 static int build_files(const camera *c, const field_files_request *q, field_files *out,
                        sub **subs_out, l2p_error *err)
 {

@@ -54,7 +54,8 @@ enum { FIELD_FACES_PER_RENDER = 20000 };
 /* render keeps a field's weights (a float a pixel and sub-image) in memory for develop up to
    this many MB; beyond, it keeps where each sub-image's pixels pass and makes the weights again
    from the pupil as it develops (fieldpass.h), which costs a little CPU. The environment's
-   LENS2POV_FIELD_WEIGHTS_MB, when set to a number of 0 or more, replaces it. */
+   LENS2POV_FIELD_WEIGHTS_MB replaces it (a number of 0 or more; field_render refuses any
+   other value). */
 #define FIELD_WEIGHTS_KEPT_MB 256.0
 
 /* trace --sampling field: the map and the renders' includes and inis, for POV-Ray and
