@@ -78,9 +78,9 @@ static void check_case(const pass_case *p)
                      c.f_number, k, differ, pixels);
         cr_expect_eq(passing, st.passed, "%s sub-image %d", p->lens, k);
         /* A row crosses the edge of the region a pupil point sees through a few times at
-           most (the fisheye's image circle has a thin passing ring outside a blocked one, and
-           a thin blocked arc inside: four runs a row), so the runs grow with the rows, not
-           with the pixels. */
+           most, so the runs grow with the rows, not with the pixels. Near the fisheye's image
+           circle some samples pass and are blocked by turns, in thin rings (docs/fields.md,
+           "Memory and disk"): four runs a row. */
         cr_expect_leq(pass.run_count, 4 * h, "%s sub-image %d: %lld runs for %d rows", p->lens,
                       k, pass.run_count, h);
         blocked += pixels - passing;
@@ -139,5 +139,63 @@ Test(field_pass, no_pixel_every_pixel_and_weights_kept)
     for (int i = 0; i < 12; i++)
         cr_expect_eq(again[i], (float)i, "pixel %d", i);
     field_pass_free(&p);   /* frees kept */
+    camera_free(&c);
+}
+
+/* A sub-image whose passing pixels come one in two (a checkerboard) would take more memory as
+   runs than as floats: its weights are kept as they are. */
+Test(field_pass, runs_that_would_outweigh_the_floats_are_not_kept)
+{
+    float *w = malloc(sizeof *w * 64);
+    cr_assert_not_null(w);
+    for (int i = 0; i < 64; i++)
+        w[i] = (float)((i + i / 8) % 2);
+    float *given = w;
+    field_pass p;
+    l2p_error err;
+    cr_assert_eq(field_pass_of(&given, 64, (film_sample){0}, 1.0, false, &p, &err), L2P_OK);
+    cr_expect(!given && p.weights == w && p.run_count == 0, "32 runs in 64 pixels were kept");
+    field_pass_free(&p);
+}
+
+#include "field/field_files.h"
+
+/* What field_files_make keeps for develop: the floats within the bound, the runs beyond it
+   (render), nothing for trace; the map in memory gives the same weights either way. */
+Test(field_pass, render_keeps_floats_within_the_bound_and_runs_beyond)
+{
+    camera_options o;
+    camera_options_default(&o);
+    o.width = 64, o.height = 48, o.spp = 4, o.seed = 1;
+    o.location = v3(0, 1, -4), o.look_at = v3(0, 1, 0);
+    camera c;
+    test_camera(&c, "fisheye.10mm", &o);
+    const char *dir = test_tmpdir();
+    const double bounds[2] = {0.0, 1e9};
+    field_files f[3];
+    l2p_error err;
+    for (int i = 0; i < 3; i++) {
+        const field_files_request q = {tmp_path(dir, i == 0 ? "a" : i == 1 ? "b" : "c"), 1,
+                                       FIELD_DEFAULT_TOLERANCE_PX, NULL, NULL, FIELD_FRAME_S,
+                                       i == 2, i < 2 ? bounds[i] : 0.0, i < 2};
+        cr_assert_eq(field_files_make(&c, &q, &f[i], &err), L2P_OK, "%s", err.text);
+    }
+    cr_expect(f[2].pass == NULL && f[2].table.weights_of == NULL, "trace keeps weights");
+    const size_t pixels = 64 * 48;
+    float *w[2] = {malloc(sizeof(float) * pixels), malloc(sizeof(float) * pixels)};
+    cr_assert(w[0] && w[1]);
+    long long runs = 0;
+    for (int k = 0; k < o.spp; k++) {
+        cr_expect(!f[0].pass[k].weights, "sub-image %d: floats kept at a bound of 0", k);
+        cr_expect_not_null(f[1].pass[k].weights, "sub-image %d: floats not kept", k);
+        runs += f[0].pass[k].run_count;
+        for (int i = 0; i < 2; i++)
+            cr_assert_eq(field_map_weights(&f[i].table, k, w[i], &err), L2P_OK, "%s", err.text);
+        cr_expect(memcmp(w[0], w[1], sizeof(float) * pixels) == 0, "sub-image %d differs", k);
+    }
+    cr_expect_gt(runs, 0, "the fisheye's image circle gives runs");
+    free(w[0]), free(w[1]);
+    for (int i = 0; i < 3; i++)
+        field_files_free(&f[i]);
     camera_free(&c);
 }

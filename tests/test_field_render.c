@@ -217,6 +217,8 @@ Test(field_render, the_weights_stay_off_the_disk_unless_the_work_folder_is_kept)
                  kept == 2 ? "remade" : kept ? "kept" : "gone");
         if (kept == 2)
             setenv("LENS2POV_FIELD_WEIGHTS_MB", "0", 1);
+        remove(tmp_path(dir, "maps"));
+        remove(tmp_path(dir, "runs"));
         char *errtext = NULL;
         const int st = kept ? L2P(NULL, &errtext, "render", scene, LENS_DIR "fisheye.10mm.dat",
                                   "--width", "48", "--height", "36", "--spp", "16", "--sampling",
@@ -229,7 +231,7 @@ Test(field_render, the_weights_stay_off_the_disk_unless_the_work_folder_is_kept)
         free(errtext);
         if (kept != 1) {
             char *maps = read_text(tmp_path(dir, "maps"), NULL);
-            cr_assert(file_exists(tmp_path(dir, "runs")), "POV-Ray never ran");
+            cr_assert(file_exists(tmp_path(dir, "runs")), "POV-Ray never ran (run %d)", kept);
             cr_expect(!maps || !*maps, "the work folder held a map: %s", maps);
             free(maps);
         }

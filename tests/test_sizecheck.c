@@ -269,3 +269,19 @@ Test(sizecheck, povrays_state_file_is_counted)
     cr_expect_geq(p.renders_bytes, 6e6 * SIZE_EXR_BYTES_PER_FACE + 1e6 * 20.0, "%.0f", p.renders_bytes);
     cr_expect_geq(f.renders_bytes, 6e6 * 20.0, "%.0f", f.renders_bytes);
 }
+
+/* In memory, render counts the weights while they fit LENS2POV_FIELD_WEIGHTS_MB (default 256
+   MB) and four runs a row beyond: 160x120 at 256 spp is 19.7 MB of floats, counted by
+   default, 256 x 4 x 120 runs of 16 bytes with the bound at 0. */
+Test(sizecheck, field_weights_in_memory_are_counted_within_the_bound)
+{
+    char *args[] = {"s.pov", "dgauss.50mm", "--width", "160", "--height", "120", "--spp", "256",
+                    "--sampling", "field", "-o", "x.png"};
+    const size_estimate floats = estimate_of(args, 12, 2);
+    setenv("LENS2POV_FIELD_WEIGHTS_MB", "0", 1);
+    const size_estimate runs = estimate_of(args, 12, 2);
+    unsetenv("LENS2POV_FIELD_WEIGHTS_MB");
+    const double want = 256 * 160.0 * 120.0 * sizeof(float) - 256 * 4 * 120.0 * 16;
+    cr_expect(fabs(floats.memory_bytes - runs.memory_bytes - want) < 1, "%.0f against %.0f",
+              floats.memory_bytes - runs.memory_bytes, want);
+}

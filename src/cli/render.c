@@ -65,6 +65,9 @@ static int check_inputs(const cli *c, l2p_error *err)
         st = outfile_check_path(c->rays_csv, err);
     if (!st && c->keep_temp)
         st = outfile_check_dir(c->keep_temp, err);
+    double weights_bytes;
+    if (!st && c->field_sampling)
+        st = field_weights_kept_bytes(&weights_bytes, err);
     return st ? st : check_workspace_path(c, err);
 }
 

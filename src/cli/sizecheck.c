@@ -110,8 +110,9 @@ static field_layout field_layout_of(const cli *c, int jobs)
 /* lens2pov keeps every sub-image's mesh until the renders are written: a face (field_mesh's
    tri) and a vertex (pos, nrm, pix, uv) a face, a margin over the half as many vertices as
    faces of a triangulated grid, and SIZE_FIELD_BYTES_PER_SUBIMAGE; and until it is developed,
-   its weights (fieldpass.h): a float a pixel while all of them fit FIELD_WEIGHTS_KEPT_MB,
-   else where its pixels pass, four runs a row of the crop (more only with more faces).
+   its weights (fieldpass.h): a float a pixel while all of them fit FIELD_WEIGHTS_KEPT_MB (or
+   the environment's bound), else where its pixels pass, four runs a row of the crop (more
+   only with more faces; never more than the floats).
    Meanwhile it builds on jobs threads (a crop pixel's ray, weight, flags, prefix sum and
    vertex index, subimage.c), waits for POV-Ray's processes, then develops (the sums, a
    sub-image's weights, a render's picture as float RGBA). */
@@ -120,7 +121,9 @@ static void field_memory(const field_layout *l, int jobs, size_estimate *e)
     const double mesh_face = 3 * sizeof(int) + 6 * sizeof(float) + 4 * sizeof(double);
     const double weights = l->spp * l->pixels * sizeof(float);
     const double runs = l->spp * 4 * l->rows * 2 * sizeof(long long);
-    const double kept = weights <= FIELD_WEIGHTS_KEPT_MB * 1048576.0 ? weights : runs;
+    double bound;
+    field_weights_kept_bytes(&bound, NULL);   /* render refuses a bad one before this */
+    const double kept = weights <= bound ? weights : fmin(runs, weights);
     const double meshes = l->spp * (l->subimage_faces * mesh_face + SIZE_FIELD_BYTES_PER_SUBIMAGE);
     const double build = jobs * l->pixels * (sizeof(ray) + sizeof(float) + 2 + 2 * sizeof(int));
     e->povray_process_bytes = POVRAY_BASE_BYTES +

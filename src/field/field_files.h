@@ -25,7 +25,8 @@ typedef struct field_files {
     char *map_path;            /* its final path (outfile forgets it once committed); NULL:
                                   none */
     field_map table;           /* the map in memory, its weights from pass */
-    field_pass *pass;          /* each sub-image's weights, kept or to be made again */
+    field_pass *pass;          /* each sub-image's weights, kept or to be made again; NULL
+                                  unless the request develops */
     const camera *camera;      /* what they are made again with */
     outfile *inc, *ini;
     povray_chunk *chunk;       /* render r's include, ini and picture paths, faces */
@@ -53,6 +54,7 @@ typedef struct field_files_request {
     /* The most bytes of weights kept in memory for render's develop; beyond, they are made
        again where the pixels pass (fieldpass.h). */
     double weights_kept_bytes;
+    bool develops;             /* render's: the table gives the weights; trace's has none */
 } field_files_request;
 
 /* That cost as POV-Ray is, and as lens2pov runs it, its polls shortened (povray_env.h): the

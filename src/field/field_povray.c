@@ -189,14 +189,13 @@ static int render_frames(const field_files *f, const povray_chunk *pc,
     return st;
 }
 
-/* FIELD_WEIGHTS_KEPT_MB, or the environment's (field_render.h), in bytes; L2P_BAD_INPUT for a
-   value that is not a number of 0 or more. */
-static int weights_kept_bytes(double *bytes, l2p_error *err)
+int field_weights_kept_bytes(double *bytes, l2p_error *err)
 {
     static const char name[] = "LENS2POV_FIELD_WEIGHTS_MB";
     const char *text = getenv(name);
     char *end = NULL;
     const double mb = text ? strtod(text, &end) : FIELD_WEIGHTS_KEPT_MB;
+    *bytes = FIELD_WEIGHTS_KEPT_MB * 1048576.0;
     if (text && (end == text || *end || !(mb >= 0.0) || !isfinite(mb)))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s in the environment is '%s', not a "
                         "number of MB, 0 or more", name, text);
@@ -206,18 +205,19 @@ static int weights_kept_bytes(double *bytes, l2p_error *err)
 
 int field_render(const camera *c, const field_render_options *o, l2p_error *err)
 {
-    double weights_bytes = 0.0;
-    if (weights_kept_bytes(&weights_bytes, err))
-        return L2P_BAD_INPUT;
+    double weights_bytes;
+    int st = field_weights_kept_bytes(&weights_bytes, err);
+    if (st)
+        return st;
     char library[PATH_MAX + 64];
     const field_files_request q = {o->prefix, o->jobs, o->tolerance_px,
                                    o->frames[0].placement ? "Lens2pov_Placement" : NULL,
                                    o->rays_csv,
                                    povray_polls_library(library, sizeof library)
                                        ? FIELD_FRAME_POLLS_S : FIELD_FRAME_S,
-                                   o->work_dir_kept, weights_bytes};
+                                   o->work_dir_kept, weights_bytes, true};
     field_files f;
-    int st = field_files_make(c, &q, &f, err);
+    st = field_files_make(c, &q, &f, err);
     if (o->too_fine)
         *o->too_fine = f.too_fine;
     /* The image library must be there before POV-Ray runs (a file check); render loads it

@@ -34,7 +34,8 @@ typedef struct job {
     const outfile *map;        /* the field map, its weights written as sub-images are built;
                                   NULL: no file */
     const samplemap_header *header;
-    field_pass *pass;          /* each sub-image's weights as kept until developed */
+    field_pass *pass;          /* each sub-image's weights as kept until developed; NULL:
+                                  not kept (trace) */
     bool keep_weights;         /* the weights themselves, not their runs */
     const field_tolerance *tol;
     field_strata strata;
@@ -87,7 +88,7 @@ static void *build_worker(void *arg)
             field_mesh_shrink(&s->mesh);   /* kept until the renders are written */
         if (!st && j->map)
             st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
-        if (!st)
+        if (!st && j->pass)
             st = field_pass_of(&s->weights, (long long)pixels, shared, scale, j->keep_weights,
                                &j->pass[k], &e);
         free(s->weights);
@@ -391,7 +392,8 @@ static int finish_map(const camera *c, const sub *subs, const field_render_plan 
 {
     const int spp = c->samples.spp;
     field_map *m = &f->table;
-    *m = (field_map){.renders = renders, .weights_of = weights_again, .weights_ctx = f};
+    *m = (field_map){.renders = renders, .weights_of = f->pass ? weights_again : NULL,
+                     .weights_ctx = f};
     povmesh_camera_header(c, &m->header);
     m->width = malloc(sizeof *m->width * (size_t)renders);
     m->height = malloc(sizeof *m->height * (size_t)renders);
@@ -455,9 +457,9 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     field_render_plan *plans = calloc((size_t)spp, sizeof *plans);
     char *map_path = q->map_file ? malloc(strlen(prefix) + 8) : NULL;
     out->camera = c;
-    out->pass = calloc((size_t)spp, sizeof *out->pass);
+    out->pass = q->develops ? calloc((size_t)spp, sizeof *out->pass) : NULL;
     *subs_out = subs;
-    if (!subs || !plans || !out->pass || (q->map_file && !map_path)) {
+    if (!subs || !plans || (q->develops && !out->pass) || (q->map_file && !map_path)) {
         free(plans), free(map_path);
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
@@ -542,7 +544,7 @@ int field_trace(const camera *c, const field_trace_options *o, field_trace_stats
 {
     /* the renders are for the user's POV-Ray, whose polls are as they are */
     const field_files_request q = {o->prefix, o->jobs, o->tolerance_px, NULL, o->rays_csv,
-                                   FIELD_FRAME_S, true, 0};
+                                   FIELD_FRAME_S, true, 0, false};
     field_files f;
     const int st = field_files_make(c, &q, &f, err);
     *stats = f.stats;

@@ -4,12 +4,18 @@
 #include <string.h>
 #include "field/subimage.h"
 
-/* The runs of passing pixels of weights into out. */
-static int runs_of(const float *weights, long long pixels, field_pass *out, l2p_error *err)
+static long long count_runs(const float *weights, long long pixels)
 {
     long long runs = 0;
     for (long long i = 0; i < pixels; i++)
         runs += weights[i] > 0 && (i == 0 || !(weights[i - 1] > 0));
+    return runs;
+}
+
+/* The runs of passing pixels of weights into out, runs of them. */
+static int runs_of(const float *weights, long long pixels, long long runs, field_pass *out,
+                   l2p_error *err)
+{
     if (runs == 0)
         return L2P_OK;
     if (!(out->runs = malloc(sizeof *out->runs * 2 * (size_t)runs)))
@@ -29,8 +35,10 @@ int field_pass_of(float **weights, long long pixels, film_sample s, double weigh
                   bool keep, field_pass *out, l2p_error *err)
 {
     *out = (field_pass){.sample = s, .weight_scale = weight_scale};
-    if (!keep)
-        return runs_of(*weights, pixels, out, err);
+    /* runs of two long longs each that would take more than the floats: the floats */
+    const long long runs = keep ? 0 : count_runs(*weights, pixels);
+    if (!keep && 4 * runs <= pixels)
+        return runs_of(*weights, pixels, runs, out, err);
     out->weights = *weights;
     *weights = NULL;
     return L2P_OK;

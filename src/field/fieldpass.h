@@ -2,7 +2,7 @@
    they take little memory, else only where the pixels pass, as runs, from which they are made
    again. All of them kept would be spp x pixels floats; the runs grow with the edges of the
    region the lens passes, as the sub-image's faces do, and making the weights again takes
-   the pupil alone, without the lens trace. Either way, nothing of them goes to disk. */
+   the pupil alone, without the lens trace. Either way, what is kept here stays in memory. */
 #ifndef LENS2POV_FIELD_FIELDPASS_H
 #define LENS2POV_FIELD_FIELDPASS_H
 
@@ -20,8 +20,9 @@ typedef struct field_pass {
 } field_pass;
 
 /* From the weights field_build_subimage gave a sub-image (those above 0 pass), seen with s and
-   weight_scale: with keep, *weights itself, which out then owns (*weights becomes NULL); else
-   the runs. L2P_FAILED out of memory. */
+   weight_scale: with keep, or when the runs would take more memory than the weights (more
+   than one run in four pixels), *weights itself, which out then owns (*weights becomes NULL);
+   else the runs. L2P_FAILED out of memory. */
 int field_pass_of(float **weights, long long pixels, film_sample s, double weight_scale,
                   bool keep, field_pass *out, l2p_error *err);
 
