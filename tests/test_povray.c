@@ -511,7 +511,12 @@ Test(povray, a_sequence_reports_each_frame_when_povray_has_closed_it)
                     "plane { -z, 0 pigment { rgb <1,0,0> } finish { ambient 1 diffuse 0 } }\n"
                     "plane { z, -10 pigment { rgb <0,1,0> } finish { ambient 1 diffuse 0 } }\n");
     char *script = fmt("%s/%s", dir, "endpov"), *ended = fmt("%s/%s", dir, "ended");
-    char *text = fmt("#!/bin/sh\npovray \"$@\"; st=$?\necho end > '%s'\nexit $st\n%s", ended, "");
+    /* POV-Ray runs in the background of the stand-in, which passes on the runner's SIGTERM
+       and waits for it: a stand-in killed with POV-Ray still running (the run stopped below)
+       would leave it writing into the test's folder while the folder is removed. */
+    char *text = fmt("#!/bin/sh\ntrap 'kill $pid 2>/dev/null; wait; exit 143' TERM\n"
+                     "povray \"$@\" & pid=$!\nwait $pid; st=$?\necho end > '%s'\nexit $st\n%s",
+                     ended, "");
     write_text(script, text);
     chmod(script, 0755);
     fixture fx;
