@@ -64,8 +64,8 @@ typedef struct field_files_request {
 
 /* Builds the sub-images and writes the map (when asked for), every render's include and ini
    and the CSV, then commits all but the CSV. L2P_BAD_INPUT naming --sampling pixel for a
-   tolerance not above 0 or a sub-image that would need more faces than pixels. *out is always set; free it with
-   field_files_free, which removes what was not committed. */
+   tolerance not above 0 or a sub-image that would need more faces than pixels. *out is always
+   set; free it with field_files_free, which removes what was not committed. */
 int field_files_make(const camera *c, const field_files_request *q, field_files *out,
                      l2p_error *err);
 void field_files_free(field_files *f);

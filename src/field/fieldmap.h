@@ -29,7 +29,7 @@ typedef struct field_map {
     field_placement *at;       /* each sub-image's render and place */
     uint32_t *band;            /* each sub-image's wavelength band (0 without dispersion) */
     char *path;                /* where the weights are read from */
-    /* Or, for render's map, whose weights are never written: what makes sub-image k's
+    /* Or, for render's map in memory: what gives sub-image k's, kept or made again
        (field_render.c, from fieldpass.h); NULL: read from path. */
     int (*weights_of)(const void *ctx, int k, float *weights, l2p_error *err);
     const void *weights_ctx;
