@@ -6,6 +6,7 @@
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdlib.h>
+#include "field/fieldpixels.h"
 #include "field/strata.h"
 #include "field/subimage.h"
 #include "optics/spectrum.h"

@@ -7,6 +7,7 @@
 #include <string.h>
 #include "field/field_render.h"
 #include "field/fieldpass.h"
+#include "field/fieldpixels.h"
 #include "field/strata.h"
 #include "field/subimage.h"
 #include "support.h"

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "field/sobol.h"
+#include "field/fieldpixels.h"
 #include "field/strata.h"
 #include "field/subimage.h"
 #include "image/image_io.h"

@@ -23,6 +23,7 @@
 #include "cli/sizecheck.h"
 #include "cli/workspace.h"
 #include "field/field_render.h"
+#include "field/fieldpass.h"
 #include "raytable/raytable.h"
 
 /* POV-Ray is given the workspace's files by name (the chunks' .ini and renders), so the

@@ -8,6 +8,7 @@
 #include <sys/statvfs.h>
 #include <sys/sysinfo.h>
 #include "field/field_render.h"
+#include "field/fieldpass.h"
 #include "field/subimage.h"
 #include "raytable/raytable.h"
 

@@ -6,7 +6,6 @@
 #include "field/field_render.h"
 
 #include <limits.h>
-#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +13,7 @@
 #include <unistd.h>
 #include "field/field_develop.h"
 #include "field/field_files.h"
+#include "field/fieldpass.h"
 #include "image/image_io.h"
 #include "povray/povargs.h"
 #include "povray/povray.h"
@@ -187,20 +187,6 @@ static int render_frames(const field_files *f, const povray_chunk *pc,
     free(d.done);
     free(d.exr);
     return st;
-}
-
-int field_weights_kept_bytes(double *bytes, l2p_error *err)
-{
-    static const char name[] = "LENS2POV_FIELD_WEIGHTS_MB";
-    const char *text = getenv(name);
-    char *end = NULL;
-    const double mb = text ? strtod(text, &end) : FIELD_WEIGHTS_KEPT_MB;
-    *bytes = FIELD_WEIGHTS_KEPT_MB * 1048576.0;
-    if (text && (end == text || *end || !(mb >= 0.0) || !isfinite(mb)))
-        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s in the environment is '%s', not a "
-                        "number of MB, 0 or more", name, text);
-    *bytes = mb * 1048576.0;
-    return L2P_OK;
 }
 
 int field_render(const camera *c, const field_render_options *o, l2p_error *err)

@@ -12,6 +12,7 @@
 #include <string.h>
 #include "field/fieldmap.h"
 #include "field/fieldpass.h"
+#include "field/fieldpixels.h"
 #include "field/fieldrays.h"
 #include "field/strata.h"
 #include "field/subimage.h"

@@ -51,16 +51,6 @@ enum { FIELD_FACES_PER_RENDER = 20000 };
    the lens blocks everything) would otherwise be packed by the dozen into one picture. */
 #define FIELD_PIXELS_PER_RENDER 16777216.0
 
-/* render keeps a field's weights (a float a pixel and sub-image) in memory for develop up to
-   this many MB; beyond, it keeps where each sub-image's pixels pass and makes the weights again
-   from the pupil as it develops (fieldpass.h), which costs a little CPU. The environment's
-   LENS2POV_FIELD_WEIGHTS_MB replaces it. */
-#define FIELD_WEIGHTS_KEPT_MB 256.0
-
-/* That bound in bytes, the environment's or the default. L2P_BAD_INPUT, naming the variable,
-   when it is set to anything but a number of 0 or more (*bytes then the default). */
-int field_weights_kept_bytes(double *bytes, l2p_error *err);
-
 /* trace --sampling field: the map and the renders' includes and inis, for POV-Ray and
    `develop` to take from there (docs/fields.md). */
 typedef struct field_trace_options {

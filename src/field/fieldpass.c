@@ -1,8 +1,23 @@
 #include "field/fieldpass.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "field/subimage.h"
+#include "field/fieldpixels.h"
+
+int field_weights_kept_bytes(double *bytes, l2p_error *err)
+{
+    static const char name[] = "LENS2POV_FIELD_WEIGHTS_MB";
+    const char *text = getenv(name);
+    char *end = NULL;
+    const double mb = text ? strtod(text, &end) : FIELD_WEIGHTS_KEPT_MB;
+    *bytes = FIELD_WEIGHTS_KEPT_MB * 1048576.0;
+    if (text && (end == text || *end || !(mb >= 0.0) || !isfinite(mb)))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s in the environment is '%s', not a "
+                        "number of MB, 0 or more", name, text);
+    *bytes = mb * 1048576.0;
+    return L2P_OK;
+}
 
 static long long count_runs(const float *weights, long long pixels)
 {

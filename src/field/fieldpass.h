@@ -10,6 +10,15 @@
 #include "base/error.h"
 #include "camera/camera.h"
 
+/* render keeps a field's weights in memory as floats up to this many MB in all; beyond, the
+   runs, since making the weights again costs a little CPU. The environment's
+   LENS2POV_FIELD_WEIGHTS_MB replaces it. */
+#define FIELD_WEIGHTS_KEPT_MB 256.0
+
+/* That bound in bytes, the environment's or the default. L2P_BAD_INPUT, naming the variable,
+   when it is set to anything but a number of 0 or more (*bytes then the default). */
+int field_weights_kept_bytes(double *bytes, l2p_error *err);
+
 typedef struct field_pass {
     float *weights;            /* kept as built, one a crop pixel; NULL: made again */
     film_sample sample;        /* the sub-image's shared sample, placed in its stratum */

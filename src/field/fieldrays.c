@@ -5,8 +5,8 @@
 #include "field/fieldrays.h"
 
 #include <stdlib.h>
+#include "field/fieldpixels.h"
 #include "field/strata.h"
-#include "field/subimage.h"
 
 static void put_row(FILE *out, const camera *c, film_sample s, long i, const sample_batch *b, int k,
                     const field_placement *at)

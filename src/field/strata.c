@@ -19,11 +19,11 @@
    of the disk. The axis is then exposed right for every seed, and off it the estimate is
    unbiased, but for the fit margin's sliver of light when the ring gets no sample
    (ring_samples). */
+#include "field/fieldpixels.h"
 #include "field/strata.h"
 
 #include <math.h>
 #include <stdlib.h>
-#include "field/subimage.h"
 #include "optics/spectrum.h"
 
 static double strata_nm(int i)
