@@ -425,7 +425,9 @@ Test(robustness, a_failed_run_leaves_the_previous_outputs_alone)
 
 /* ---------------------------------------------------------------- killed while writing */
 
-static pid_t spawn_lens2pov(char *const argv[], const char *tmpdir)
+/* With attr (NULL: none), as posix_spawn takes it. */
+static pid_t spawn_lens2pov_with(char *const argv[], const char *tmpdir,
+                                 const posix_spawnattr_t *attr)
 {
     const char *bin = getenv("LENS2POV");
     if (!bin)
@@ -455,10 +457,15 @@ static pid_t spawn_lens2pov(char *const argv[], const char *tmpdir)
         args[i + 2] = NULL;
     }
     pid_t pid;
-    cr_assert_eq(posix_spawn(&pid, bin, &fa, NULL, args, env), 0);
+    cr_assert_eq(posix_spawn(&pid, bin, &fa, attr, args, env), 0);
     posix_spawn_file_actions_destroy(&fa);
     free(env);
     return pid;
+}
+
+static pid_t spawn_lens2pov(char *const argv[], const char *tmpdir)
+{
+    return spawn_lens2pov_with(argv, tmpdir, NULL);
 }
 
 /* Whether dir holds a file whose name contains part, with at least min_bytes. */
@@ -620,6 +627,91 @@ Test(robustness, an_animation_stopped_midway_keeps_its_finished_frames)
         cr_expect_eq(unexpected_files(dir, allowed, &left), 0, "%s: left %s", samplings[k], left);
         remove_tree(dir);
     }
+}
+
+/* The state letter of process pid (/proc/PID/stat: R, S, T, Z, ...); 0 when it is gone. */
+static char process_state(int pid)
+{
+    char path[64], text[512] = "";
+    snprintf(path, sizeof path, "/proc/%d/stat", pid);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    const size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    const char *paren = strrchr(text, ')');   /* the command's name may hold anything */
+    return paren && paren[1] == ' ' ? paren[2] : 0;
+}
+
+/* A user's POV-Ray wrapper that does not exec POV-Ray (a stand-in whose "render" is a sleeper
+   in its background; the scene-camera probe, -F, runs POV-Ray as it is): Ctrl-Z (SIGTSTP)
+   stops the sleeper with render, SIGCONT continues both, and SIGTERM ends render with
+   everything it started and leaves nothing behind. */
+Test(robustness, a_wrappers_povray_is_stopped_continued_and_ended_with_render)
+{
+    const char *dir = test_tmpdir();
+    char scene[512], script[512], out[512], pidfile[512];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(script, sizeof script, "%s/wrapper", dir);
+    snprintf(out, sizeof out, "%s/out.png", dir);
+    snprintf(pidfile, sizeof pidfile, "%s/sleeper.pid", dir);
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
+                      "background { rgb 0.3 }\n");
+    char text[2000];
+    snprintf(text, sizeof text, "#!/bin/sh\ncase \" $* \" in *\" -F \"*) exec povray \"$@\";; esac\n"
+                                "sleep 60 & echo $! > '%s/sleeper.tmp' && mv '%s/sleeper.tmp' '%s'\nwait\n",
+             dir, dir, pidfile);
+    write_text(script, text);
+    chmod(script, 0755);
+    setenv("LENS2POV_POVRAY", script, 1);
+    char *argv[] = {"render", scene, DGAUSS, "--width", "16", "--height", "12", "--spp", "2",
+                    "--jobs", "1", "-o", out, "--quiet", NULL};
+    /* As a shell with job control starts it: a process group of its own, whose parent is
+       outside it (in an orphaned group, as the runner's may be, the system discards a stop),
+       and SIGTSTP neither ignored nor blocked. */
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    sigset_t tstp, none;
+    sigemptyset(&tstp);
+    sigaddset(&tstp, SIGTSTP);
+    sigemptyset(&none);
+    posix_spawnattr_setsigdefault(&attr, &tstp);
+    posix_spawnattr_setsigmask(&attr, &none);
+    posix_spawnattr_setpgroup(&attr, 0);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF |
+                                        POSIX_SPAWN_SETSIGMASK);
+    const pid_t pid = spawn_lens2pov_with(argv, dir, &attr);
+    posix_spawnattr_destroy(&attr);
+    unsetenv("LENS2POV_POVRAY");
+    for (int waited = 0; waited < 60000 && !has_file(dir, "sleeper.pid", 1); waited += 10)
+        sleep_ms(10);
+    FILE *f = fopen(pidfile, "r");
+    int sleeper = 0;
+    cr_assert(f && fscanf(f, "%d", &sleeper) == 1, "the wrapper never started its sleeper");
+    fclose(f);
+    cr_expect_neq(process_state(sleeper), 'T', "the sleeper is stopped before Ctrl-Z");
+    cr_assert_eq(kill(pid, SIGTSTP), 0);
+    int status = 0;
+    cr_assert_eq(waitpid(pid, &status, WUNTRACED), pid);
+    cr_expect(WIFSTOPPED(status), "render did not stop: status %#x", status);
+    char state = 0;
+    for (int waited = 0; waited < 5000 && (state = process_state(sleeper)) != 'T'; waited += 10)
+        sleep_ms(10);
+    cr_expect_eq(state, 'T', "the sleeper is not stopped with render: %c", state);
+    cr_assert_eq(kill(pid, SIGCONT), 0);
+    for (int waited = 0; waited < 5000 && (state = process_state(sleeper)) == 'T'; waited += 10)
+        sleep_ms(10);
+    cr_expect(state && state != 'T', "the sleeper is not continued with render: %c", state);
+    cr_assert_eq(kill(pid, SIGTERM), 0);
+    cr_assert_eq(waitpid(pid, &status, 0), pid);
+    cr_expect(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM, "status %#x", status);
+    cr_expect(kill(sleeper, 0) != 0 && errno == ESRCH, "the sleeper %d is still there (%c)",
+              sleeper, process_state(sleeper));
+    const char *const allowed[] = {"scene.pov", "wrapper", "sleeper.pid", NULL};
+    const char *left;
+    cr_expect_eq(unexpected_files(dir, allowed, &left), 0, "left %s", left);
+    remove_tree(dir);
 }
 
 /* Temporary files are created exclusively under unpredictable names: symbolic links planted at

@@ -51,15 +51,17 @@ static void workspace_size(const char *dir, double *bytes, double *faces)
 
 /* Has every POV-Ray process that lens2pov starts note its start on a line of dir/starts and
    write its peak resident size, in kilobytes (GNU time), on a line of dir/peaks. lens2pov
-   kills a process once its pictures are in, so GNU time runs in the background of the script
-   it kills, and notes the peak when POV-Ray has wound down (wait_for_peaks). */
+   kills a process once its pictures are in, with its process group, so GNU time runs in a
+   session of its own (setsid) in the background of the script it kills, and notes the peak
+   when POV-Ray has wound down (wait_for_peaks). */
 static void record_povray_peaks(const char *dir)
 {
     char script[1200], text[2600];
     snprintf(script, sizeof script, "%s/timepov", dir);
     snprintf(text, sizeof text,
              "#!/bin/sh\necho s >> '%s/starts'\n"
-             "/usr/bin/time -a -o '%s/peaks' -f '%%M' povray \"$@\" &\nwait $!\n", dir, dir);
+             "setsid /usr/bin/time -a -o '%s/peaks' -f '%%M' povray \"$@\" &\nwait $!\n",
+             dir, dir);
     write_text(script, text);
     chmod(script, 0755);
     setenv("LENS2POV_POVRAY", script, 1);

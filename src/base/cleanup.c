@@ -2,9 +2,11 @@
 #define _GNU_SOURCE
 #include "base/cleanup.h"
 
+#include <errno.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -53,6 +55,41 @@ void cleanup_untrack_child(pid_t pid)
             children[i] = 0;
 }
 
+void cleanup_child_own_group(void)
+{
+    setpgid(0, 0);
+}
+
+void cleanup_track_child_group(pid_t pid)
+{
+    setpgid(pid, pid);   /* as the child does itself: whichever comes first */
+    prctl(PR_SET_CHILD_SUBREAPER, 1);   /* what it leaves behind comes to us */
+    cleanup_track_child(pid);
+}
+
+int cleanup_signal_child(pid_t pid, int sig)
+{
+    return kill(-pid, sig) == 0 || errno != ESRCH ? 0 : kill(pid, sig);
+}
+
+bool cleanup_reap_child_group(pid_t pid)
+{
+    pid_t w;
+    while ((w = waitpid(-pid, NULL, WNOHANG)) > 0 || (w < 0 && errno == EINTR))
+        continue;
+    return w < 0;
+}
+
+void cleanup_end_child_group(pid_t pid)
+{
+    /* What is left is ours (the subreaper) and keeps the group's number from being reused. */
+    if (cleanup_reap_child_group(pid))
+        return;
+    kill(-pid, SIGKILL);
+    while (waitpid(-pid, NULL, 0) > 0 || errno == EINTR)
+        continue;
+}
+
 /* A folder, with whatever is in it, goes through rm -rf in a child process: _Fork, execve and
    waitpid are async-signal-safe, readdir is not. Not fork: glibc's takes malloc's locks, and a
    signal that came inside malloc (dlopen of the image library, on this thread) deadlocked. */
@@ -76,14 +113,43 @@ static void remove_tracked_and_die(int sig)
 {
     for (int i = 0; i < MAX_CHILDREN; i++)
         if (children[i] > 0) {
-            kill(children[i], SIGTERM);
-            waitpid(children[i], NULL, 0);
+            cleanup_signal_child(children[i], SIGTERM);
+            while (waitpid(-children[i], NULL, 0) > 0 || errno == EINTR)
+                continue;
+            while (waitpid(children[i], NULL, 0) < 0 && errno == EINTR)   /* one of ours */
+                continue;
         }
     for (int i = MAX_TRACKED - 1; i >= 0; i--)
         if (tracked[i])
             remove_path(tracked[i]);
     signal(sig, SIG_DFL);
     raise(sig);
+}
+
+/* Ctrl-Z: the children, each in a process group of its own that the terminal does not stop,
+   are stopped with us and continued with us (the job-control handler of Stevens and Rago,
+   "Advanced Programming in the UNIX Environment", 10.20). Only async-signal-safe calls. */
+static void stop_with_children(int sig)
+{
+    const int saved = errno;
+    for (int i = 0; i < MAX_CHILDREN; i++)
+        if (children[i] > 0)
+            cleanup_signal_child(children[i], SIGSTOP);
+    sigset_t tstp;
+    sigemptyset(&tstp);
+    sigaddset(&tstp, sig);
+    signal(sig, SIG_DFL);
+    raise(sig);
+    sigprocmask(SIG_UNBLOCK, &tstp, NULL);   /* stops here until SIGCONT */
+    sigprocmask(SIG_BLOCK, &tstp, NULL);
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = stop_with_children;
+    sigaction(sig, &sa, NULL);
+    for (int i = 0; i < MAX_CHILDREN; i++)
+        if (children[i] > 0)
+            cleanup_signal_child(children[i], SIGCONT);
+    errno = saved;
 }
 
 void cleanup_block_signals(sigset_t *old)
@@ -114,4 +180,9 @@ void cleanup_install(void)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     sigaction(SIGHUP, &sa, NULL);
+    struct sigaction was;   /* a shell without job control has it ignored: so do we */
+    if (sigaction(SIGTSTP, NULL, &was) == 0 && was.sa_handler != SIG_IGN) {
+        sa.sa_handler = stop_with_children;
+        sigaction(SIGTSTP, &sa, NULL);
+    }
 }

@@ -40,7 +40,8 @@ static void write_text(int fd, const char *a, const char *b)
         return;
 }
 
-/* In the child: default signal handling (ours would remove the run's files), SIGTERM when
+/* In the child: a process group of its own (what it starts is stopped with it), default
+   signal handling (ours would remove the run's files), SIGTERM when
    lens2pov dies however it dies (SIGKILL, the out-of-memory killer: the parent-death signal
    outlives execve; lens2pov forks from its main thread, whose end is the process's), stdin from
    /dev/null, stdout and stderr into the log, the scene's folder as working folder. Only
@@ -48,6 +49,7 @@ static void write_text(int fd, const char *a, const char *b)
 static void exec_child(const run *r, char **argv, int log_fd, const sigset_t *old_mask,
                        pid_t parent)
 {
+    cleanup_child_own_group();
     prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (getppid() != parent)   /* the parent died before prctl: nothing would stop us */
         _exit(127);
@@ -79,7 +81,7 @@ static pid_t spawn(const run *r, char **argv, int log_fd)
     if (pid == 0)
         exec_child(r, argv, log_fd, &old, parent);
     if (pid > 0)
-        cleanup_track_child(pid);
+        cleanup_track_child_group(pid);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     return pid;
 }
@@ -121,12 +123,13 @@ static void sleep_ms(int ms)
     nanosleep(&t, NULL);
 }
 
-/* Stops every running job: SIGTERM, up to 5 s, then SIGKILL; reaps all of them. */
+/* Stops every running job, with what it started (a wrapper's POV-Ray): SIGTERM to its
+   process group, up to 5 s, then SIGKILL; reaps all of them. */
 static void stop_jobs(run *r)
 {
     for (int i = 0; i < r->job_slots; i++)
         if (r->jobs[i].pid)
-            kill(r->jobs[i].pid, SIGTERM);
+            cleanup_signal_child(r->jobs[i].pid, SIGTERM);
     for (int tick = 0;; tick++) {
         int running = 0;
         for (int i = 0; i < r->job_slots; i++) {
@@ -134,9 +137,8 @@ static void stop_jobs(run *r)
             if (!j->pid)
                 continue;
             if (tick == STOP_WAIT_TICKS)
-                kill(j->pid, SIGKILL);
-            const pid_t w = waitpid(j->pid, NULL, tick >= STOP_WAIT_TICKS ? 0 : WNOHANG);
-            if (w == j->pid || (w < 0 && errno == ECHILD)) {
+                cleanup_end_child_group(j->pid);   /* SIGKILL, then reaped */
+            if (cleanup_reap_child_group(j->pid)) {
                 cleanup_untrack_child(j->pid);
                 j->pid = 0;
             } else {
@@ -272,6 +274,7 @@ static int reap_jobs(run *r, int *chunks, int *st, l2p_error *err)
         int status;
         if (!j->pid || waitpid(j->pid, &status, WNOHANG) != j->pid)
             continue;
+        cleanup_end_child_group(j->pid);   /* a wrapper that ended leaves nothing running */
         cleanup_untrack_child(j->pid);
         j->pid = 0;
         if (retried(r, j, status, st, err))
@@ -305,9 +308,10 @@ static int retire_done_tasks(run *r, int *chunks, int *st, l2p_error *err)
         if (!j->pid || !all_reported(r, j->task))
             continue;
         int status = 0;
-        kill(j->pid, SIGKILL);
+        cleanup_signal_child(j->pid, SIGKILL);
         while (waitpid(j->pid, &status, 0) < 0 && errno == EINTR)
             continue;
+        cleanup_end_child_group(j->pid);
         if (!*st && WIFEXITED(status) && WEXITSTATUS(status) != 0)
             *st = explain_failure(r, j, status, err);
         cleanup_untrack_child(j->pid);

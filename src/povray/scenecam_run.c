@@ -133,16 +133,16 @@ static int wait_probe(pid_t pid, const char *log, bool early)
     int status = 0;
     for (long pos = 0, stage = 0;;) {
         const pid_t w = waitpid(pid, &status, early ? WNOHANG : 0);
-        if (w == pid)
+        if (w == pid) {
+            cleanup_end_child_group(pid);   /* a wrapper that ended leaves nothing running */
             return status;
+        }
         if (w < 0 && errno != EINTR)
             return 1 << 8;
         if (w == 0 && log_has(log, DONE_MARKS[stage], &pos)) {
             if (++stage < DONE_STAGES)
                 continue;
-            kill(pid, SIGKILL);
-            while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
-                continue;
+            cleanup_end_child_group(pid);
             return 0;
         }
         nanosleep(&(struct timespec){0, 5000000L}, NULL);
@@ -191,6 +191,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     cleanup_block_signals(&old);
     const pid_t pid = fork();
     if (pid == 0) {
+        cleanup_child_own_group();
         prctl(PR_SET_PDEATHSIG, SIGTERM);   /* gone with lens2pov, however it ends */
         signal(SIGINT, SIG_DFL);
         signal(SIGTERM, SIG_DFL);
@@ -207,7 +208,7 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
         _exit(127);
     }
     if (pid > 0)
-        cleanup_track_child(pid);
+        cleanup_track_child_group(pid);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     close(fd);
     free(argv);
