@@ -328,54 +328,21 @@ Test(povray, two_chunks_render_in_parallel)
     free(dir);
 }
 
-/* As above, with a stand-in that does not exec what it runs, as a user's wrapper in
-   LENS2POV_POVRAY may not: the sleeper it starts in the background is stopped with it and
-   reaped, not left running once the wrapper is gone. */
-Test(povray, a_failure_stops_what_a_wrapper_started)
-{
-    char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
-    char *script = fmt("%s/%s", dir, "wrapper"), *pidfile = fmt("%s/%s", dir, "sleeper.pid");
-    write_text(scene, MODERN_SCENE);
-    char *text = fmt("#!/bin/sh\ncase \"$*\" in\n*c001*) sleep 60 & echo $! > '%s'; wait;;\n"
-                     "*) while [ ! -s '%s' ]; do sleep 0.05; done\n"
-                     "   echo \"File '/x/y.pov' line 7: Parse Error: broken\" >&2; exit 1;;\nesac\n",
-                     pidfile, pidfile);
-    write_text(script, text);
-    free(text);
-    chmod(script, 0755);
-    fixture fx;
-    make_chunks(&fx, dir, 2, (const int[]){1, 1});
-    povray_options o = options(scene, dir, 2);
-    o.povray = script;
-    l2p_error err = {0};
-    cr_assert_eq(povray_render_chunks(fx.chunk, 2, &o, &err), L2P_BAD_INPUT);
-    cr_expect_str_eq(err.text, "/x/y.pov:7: broken");
-    FILE *f = fopen(pidfile, "r");
-    cr_assert_not_null(f, "the sleeper never started");
-    int pid = 0;
-    cr_expect_eq(fscanf(f, "%d", &pid), 1);
-    fclose(f);
-    cr_expect(pid > 0 && kill(pid, 0) != 0 && errno == ESRCH, "sleeper %d still there", pid);
-    cr_expect(waitpid(-1, NULL, WNOHANG) < 0 && errno == ECHILD, "a child is left");
-    free_fixture(&fx);
-    free(scene);
-    free(script);
-    free(pidfile);
-    remove_tree(dir);
-    free(dir);
-}
-
-/* A failing chunk stops the other one (a stand-in for POV-Ray that would sleep for a minute):
-   the call returns at once, the sleeper is gone and nothing is left to reap. */
-Test(povray, a_failure_stops_the_other_processes)
+/* A failing chunk stops the other one, whose stand-in for POV-Ray would sleep for a minute:
+   the call returns at once, the sleeper is gone and nothing is left to reap. With exec the
+   stand-in becomes the sleeper; without, it starts the sleeper in its background and waits,
+   as a user's wrapper in LENS2POV_POVRAY may, and the sleeper must be stopped with it. */
+static void expect_a_failure_stops_the_sleeper(bool exec)
 {
     char *dir = strdup(test_tmpdir()), *scene = fmt("%s/%s", dir, "scene.pov");
     char *script = fmt("%s/%s", dir, "fakepov"), *pidfile = fmt("%s/%s", dir, "sleeper.pid");
     write_text(scene, MODERN_SCENE);
-    char *text = fmt("#!/bin/sh\ncase \"$*\" in\n*c001*) echo $$ > '%s'; exec sleep 60;;\n"
-                     "*) while [ ! -s '%s' ]; do sleep 0.05; done\n"
+    const char *sleeper = exec ? "echo $$ > \"$p\"; exec sleep 60"
+                               : "sleep 60 & echo $! > \"$p\"; wait";
+    char *text = fmt("#!/bin/sh\np='%s'\ncase \"$*\" in\n*c001*) %s;;\n"
+                     "*) while [ ! -s \"$p\" ]; do sleep 0.05; done\n"
                      "   echo \"File '/x/y.pov' line 7: Parse Error: broken\" >&2; exit 1;;\nesac\n",
-                     pidfile, pidfile);
+                     pidfile, sleeper);
     write_text(script, text);
     free(text);
     chmod(script, 0755);
@@ -400,6 +367,16 @@ Test(povray, a_failure_stops_the_other_processes)
     free(pidfile);
     remove_tree(dir);
     free(dir);
+}
+
+Test(povray, a_failure_stops_the_other_processes)
+{
+    expect_a_failure_stops_the_sleeper(true);
+}
+
+Test(povray, a_failure_stops_what_a_wrapper_started)
+{
+    expect_a_failure_stops_the_sleeper(false);
 }
 
 /* POV-Ray's "Timed out waiting for worker thread startup" (a loaded machine) is passing: the
