@@ -130,10 +130,12 @@ test-sanitize: deps
 bench: deps $(BUILD)/lens2pov $(BUILD)/bench_trace
 	sh tools/bench.sh $(BUILD)
 
-# Ray fields' error against time on the four standard lenses (tools/bench_field_error.sh):
-# longer than the rest of make bench, so a target of its own.
+# Ray fields' error against time on the four standard lenses (tools/bench_field_error.sh),
+# uniform and with --adaptive (the references are shared): longer than the rest of make bench,
+# so a target of its own.
 bench-field-error: deps $(BUILD)/lens2pov
 	sh tools/bench_field_error.sh $(BUILD)
+	FIELD_OPTS=--adaptive sh tools/bench_field_error.sh $(BUILD)
 
 $(BUILD)/bench_trace: tools/bench_trace.c $(BUILD)/liblens2pov.a
 	$(CC) $(CFLAGS_BASE) $^ -o $@ $(LDLIBS)

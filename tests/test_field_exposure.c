@@ -125,7 +125,7 @@ static bool trace_at(const camera *c, vec3 p, double u, double v, double nm, dou
 static double field_centre(const camera *c, int *core_count)
 {
     field_strata t;
-    field_strata_count(c, &t);
+    field_strata_count(c, c->samples.spp, &t);
     *core_count = t.on ? t.core_count : c->samples.spp;
     double sum = 0.0, w;
     for (int k = 0; k < c->samples.spp; k++) {
@@ -209,7 +209,7 @@ Test(field_exposure, the_strata_get_fixed_shares)
                 camera c;
                 setup_case(&c, e, NAN, spp, seed);
                 field_strata t;
-                field_strata_count(&c, &t);
+                field_strata_count(&c, c.samples.spp, &t);
                 cr_assert(t.on, "%s, %d spp", case_name(e), spp);
                 if (margin_only)
                     cr_expect(fabs(field_strata_core_radius(&t, 587.6) * PUPIL_FIT_MARGIN - 1.0) < 1e-6,
@@ -261,7 +261,7 @@ Test(field_exposure, the_strata_get_fixed_shares)
         camera c;
         test_camera(&c, "dgauss.50mm", &o);
         field_strata t;
-        field_strata_count(&c, &t);
+        field_strata_count(&c, c.samples.spp, &t);
         film_sample s = field_shared_sample(&c, 0, NULL);
         const film_sample before = s;
         cr_expect(!t.on && field_strata_place(&t, &s) == 1.0 && s.pupil_u == before.pupil_u &&
@@ -341,7 +341,7 @@ Test(field_exposure, the_strata_integrate_what_the_whole_pupil_does)
                 continue;
             setup_case(&c, &CASES[i], f ? 8.0 : NAN, 256, 1);
             field_strata t;
-            field_strata_count(&c, &t);
+            field_strata_count(&c, c.samples.spp, &t);
             uint64_t state = 12345;
             cr_assert(t.on && t.ring_count >= 1 && t.ring_count == lround(256 * (1.0 - t.ring_from)),
                       "%s: %d in the ring", name, t.ring_count);
@@ -410,7 +410,7 @@ Test(field_exposure, the_fit_margin_passes_little_light)
         camera c;
         setup_case(&c, &CASES[i], NAN, 16, 1);
         field_strata t;
-        field_strata_count(&c, &t);
+        field_strata_count(&c, c.samples.spp, &t);
         cr_assert(t.on && t.ring_count == 0, "%s: %d in the ring", CASES[i].lens, t.ring_count);
         uint64_t state = 12345;
         for (int j = 0; j <= 10; j++) {

@@ -232,3 +232,57 @@ Test(field_files, the_map_is_checked)
     cr_expect(strstr(err.text, "sub-image 0"), "%s", err.text);
     free(bytes);
 }
+
+/* render --adaptive with --keep-temp: the work folder's map is a map of pieces (version 2),
+   and develop makes render's picture from it and the renders, pixel for pixel. The map's
+   bytes are checked as version 1's are: truncated, a sub-image outside the crop, outside its
+   render. */
+Test(field_files, an_adaptive_render_develops_again_from_its_work_folder)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *work = tmp_path(dir, "work"), *rendered = tmp_path(dir, "render.exr");
+    run_lens2pov_ok("render", "render", tmp_path(dir, "scene.pov"), LENS_DIR "telephoto.250mm.dat",
+                    "--width", "40", "--height", "30", "--spp", "16", "--adaptive", "--location",
+                    "0,1,-4", "--look-at", "0,0.6,0", "--focus-distance", "4", "--keep-temp", work,
+                    "--quiet", "-o", rendered, NULL);
+    char prefix[1024], path[1100];
+    snprintf(prefix, sizeof prefix, "%s/field", work);
+    snprintf(path, sizeof path, "%s.map", prefix);
+    field_map m;
+    l2p_error err;
+    cr_assert_eq(field_map_read(path, &m, &err), 0, "%s", err.text);
+    cr_expect(m.header.spp == 16 && m.piece && m.subimages > 4, "spp %d, %d sub-images",
+              m.header.spp, m.subimages);
+    const int subimages = m.subimages;
+    field_map_free(&m);
+    const char *developed = tmp_path(dir, "developed.exr");
+    run_lens2pov_ok("develop", "develop", prefix, "-o", developed, NULL);
+    float *a = read_picture(rendered), *b = read_picture(developed);
+    for (int i = 0; i < 40 * 30 * 4; i++)
+        cr_assert(a[i] == b[i], "pixel %d, channel %d: render %g, develop %g", i / 4, i % 4, a[i], b[i]);
+    free(a), free(b);
+
+    size_t length;
+    char *bytes = read_text(path, &length);
+    write_bytes(path, bytes, length - 1);
+    cr_assert_eq(field_map_read(path, &m, &err), L2P_BAD_INPUT);
+    cr_expect(strstr(err.text, "field.map") && strstr(err.text, "truncated"), "%s", err.text);
+    /* the last sub-image's record, after the header and the renders' sizes: dx 4 bytes in,
+       x0 16 */
+    const char *renders = strstr(bytes, "\nrenders ");
+    cr_assert_not_null(renders);
+    const long long record = SAMPLEMAP_HEADER_BYTES + 8LL * atoi(renders + 9) + 32LL * (subimages - 1);
+    char *changed = malloc(length);
+    memcpy(changed, bytes, length);
+    changed[record + 16] = 40;   /* x0 = 40: the crop is 40 wide */
+    write_bytes(path, changed, length);
+    cr_assert_eq(field_map_read(path, &m, &err), L2P_BAD_INPUT);
+    cr_expect(strstr(err.text, "does not lie in the crop"), "%s", err.text);
+    memcpy(changed, bytes, length);
+    changed[record + 4] = (char)0xf0;   /* dx far beyond its render */
+    write_bytes(path, changed, length);
+    cr_assert_eq(field_map_read(path, &m, &err), L2P_BAD_INPUT);
+    cr_expect(strstr(err.text, "does not lie in a render"), "%s", err.text);
+    free(changed), free(bytes);
+}

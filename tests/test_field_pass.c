@@ -48,7 +48,7 @@ static void check_case(const pass_case *p)
     field_tolerance t;
     field_tolerance_of(&c, FIELD_DEFAULT_TOLERANCE_PX, &t);
     field_strata strata;
-    field_strata_count(&c, &strata);
+    field_strata_count(&c, c.samples.spp, &strata);
     const int w = c.crop_x1 - c.crop_x0, h = c.crop_y1 - c.crop_y0;
     const long long pixels = (long long)w * h;
     float *built = malloc(sizeof *built * (size_t)pixels);
@@ -176,9 +176,11 @@ Test(field_pass, render_keeps_floats_within_the_bound_and_runs_beyond)
     field_files f[3];
     l2p_error err;
     for (int i = 0; i < 3; i++) {
-        const field_files_request q = {tmp_path(dir, i == 0 ? "a" : i == 1 ? "b" : "c"), 1,
-                                       FIELD_DEFAULT_TOLERANCE_PX, NULL, NULL, FIELD_FRAME_S,
-                                       i == 2, i < 2 ? bounds[i] : 0.0, i < 2};
+        const field_files_request q = {.prefix = tmp_path(dir, i == 0 ? "a" : i == 1 ? "b" : "c"),
+                                       .jobs = 1, .tolerance_px = FIELD_DEFAULT_TOLERANCE_PX,
+                                       .frame_s = FIELD_FRAME_S, .map_file = i == 2,
+                                       .weights_kept_bytes = i < 2 ? bounds[i] : 0.0,
+                                       .develops = i < 2};
         cr_assert_eq(field_files_make(&c, &q, &f[i], &err), L2P_OK, "%s", err.text);
     }
     cr_expect(f[2].pass == NULL && f[2].table.weights_of == NULL, "trace keeps weights");

@@ -34,20 +34,23 @@ static camera_options options(void)
     return o;
 }
 
-/* Renders with --rays and --keep-temp WORK; returns the CSV's rows. */
-static field_csv_ray *render_with_rays(const char *dir, size_t *n)
+/* Renders with --rays and --keep-temp WORK, at SPP samples or with --adaptive at a mean of
+   ADAPTIVE_SPP; returns the CSV's rows. */
+enum { ADAPTIVE_SPP = 16 };
+
+static field_csv_ray *render_with_rays(const char *dir, bool adaptive, size_t *n)
 {
     write_text(tmp_path(dir, "scene.pov"), SCENE);
     char scene[1024], out[1024], csv[1024], work[1024];
     snprintf(scene, sizeof scene, "%s/scene.pov", dir);
-    snprintf(out, sizeof out, "%s/out.png", dir);
+    snprintf(out, sizeof out, "%s/out.exr", dir);
     snprintf(csv, sizeof csv, "%s/rays.csv", dir);
     snprintf(work, sizeof work, "%s/work", dir);
     char *errtext = NULL;
     int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "fisheye.10mm.dat", "--width", "64", "--height",
-                 "48", "--crop", "2,3,50,40", "--spp", "4", "--seed", "5", "--location", "0,1,-4",
-                 "--look-at", "0,1,0", "--sampling", "field", "--jobs", "2", "--keep-temp", work,
-                 "--rays", csv, "--quiet", "-o", out);
+                 "48", "--crop", "2,3,50,40", "--spp", adaptive ? "16" : "4", "--seed", "5", "--location",
+                 "0,1,-4", "--look-at", "0,1,0", "--sampling", "field", "--jobs", "2", "--keep-temp", work,
+                 "--rays", csv, "--quiet", "-o", out, adaptive ? "--adaptive" : "--quiet");
     cr_assert_eq(st, 0, "render: %s", errtext ? errtext : "");
     free(errtext);
     return read_field_rays_csv(csv, n);
@@ -65,12 +68,12 @@ Test(field_rays, the_rows_are_the_passing_pixels_with_their_exact_rays)
 {
     const char *dir = test_tmpdir();
     size_t n;
-    field_csv_ray *rows = render_with_rays(dir, &n);
+    field_csv_ray *rows = render_with_rays(dir, false, &n);
     camera_options o = options();
     camera c;
     test_camera(&c, "fisheye.10mm", &o);
     field_strata t;
-    field_strata_count(&c, &t);
+    field_strata_count(&c, c.samples.spp, &t);
     size_t next = 0, blocked = 0;
     for (uint32_t k = 0; k < SPP; k++) {
         film_sample s = sobol_shared_sample(SEED, k);
@@ -149,12 +152,10 @@ static double error_px(const field_tolerance *t, const ray *exact, vec3 o, vec3 
    POV-Ray writes): read the way POV-Ray reads distribution 3, that render's include gives
    that pixel the row's ray within the tolerance (neighbouring pixels' rays are a pixel
    apart); no two rows name the same pixel, and every pixel any include traces is named by a
-   row. In the pictures the real POV-Ray wrote, exactly the named pixels are lit. */
-Test(field_rays, each_row_names_the_render_pixel_that_carries_its_ray)
+   row. In the pictures the real POV-Ray wrote, exactly the named pixels are lit. Returns the
+   number of renders. */
+static int expect_rows_name_their_render_pixels(const char *dir, const field_csv_ray *rows, size_t n)
 {
-    const char *dir = test_tmpdir();
-    size_t n;
-    field_csv_ray *rows = render_with_rays(dir, &n);
     camera_options o = options();
     camera c;
     test_camera(&c, "fisheye.10mm", &o);
@@ -163,11 +164,11 @@ Test(field_rays, each_row_names_the_render_pixel_that_carries_its_ray)
     const double front = c.lens.surface[0].vertex_z_mm;
     char work[1024];
     snprintf(work, sizeof work, "%s/work", dir);
-    render_files f[SPP];
+    enum { MOST = 64 };
+    render_files f[MOST];
     int renders = 0;
-    while (renders < SPP && load_render(work, renders, &f[renders]))
+    while (renders < MOST && load_render(work, renders, &f[renders]))
         renders++;
-    cr_assert_eq(renders, 2, "4 sub-images on 2 jobs: 2 renders, found %d", renders);
     double worst = 0;
     for (size_t i = 0; i < n; i++) {
         const field_csv_ray *row = &rows[i];
@@ -212,8 +213,58 @@ Test(field_rays, each_row_names_the_render_pixel_that_carries_its_ray)
     cr_log_info("%zu rows in %d renders, worst %.3g px", n, renders, worst);
     for (int r = 0; r < renders; r++)
         povuv_mesh_free(&f[r].mesh), free(f[r].rgba), free(f[r].claimed);
-    free(rows);
     camera_free(&c);
+    return renders;
+}
+
+Test(field_rays, each_row_names_the_render_pixel_that_carries_its_ray)
+{
+    const char *dir = test_tmpdir();
+    size_t n;
+    field_csv_ray *rows = render_with_rays(dir, false, &n);
+    const int renders = expect_rows_name_their_render_pixels(dir, rows, n);
+    cr_expect_eq(renders, 2, "4 sub-images on 2 jobs: 2 renders, found %d", renders);
+    free(rows);
+}
+
+/* The same of --adaptive, whose second round renders single tiles: on a white background the
+   tiles' estimates still differ where the weights do (the image circle's edge, cos^4), so
+   some pixels get more samples than others. Each pixel's rows then add up to its irradiance
+   as the picture counts it: their weights over the mean count, each pixel the mean of its
+   tile's samples. */
+Test(field_rays, each_adaptive_row_names_the_render_pixel_that_carries_its_ray)
+{
+    const char *dir = test_tmpdir();
+    size_t n;
+    field_csv_ray *rows = render_with_rays(dir, true, &n);
+    expect_rows_name_their_render_pixels(dir, rows, n);
+    enum { W = CROP_X1 - CROP_X0, H = CROP_Y1 - CROP_Y0 };
+    static int count[W * H];
+    static double weight[W * H];
+    for (size_t i = 0; i < n; i++) {
+        const int x = (int)floor(rows[i].ray.raster_x) - CROP_X0, y = (int)floor(rows[i].ray.raster_y) - CROP_Y0;
+        cr_assert(x >= 0 && y >= 0 && x < W && y < H, "row %zu: raster %g,%g", i, rows[i].ray.raster_x,
+                  rows[i].ray.raster_y);
+        count[y * W + x]++;
+        weight[y * W + x] += rows[i].ray.weight / ADAPTIVE_SPP;
+    }
+    int least = n > 0 ? count[0] : 0, most = least;
+    for (int i = 0; i < W * H; i++)
+        least = count[i] < least ? count[i] : least, most = count[i] > most ? count[i] : most;
+    cr_expect_gt(most, ADAPTIVE_SPP, "no pixel got more than the mean: no second round");
+    /* the picture, white seen through the lens: each pixel its rows' weights over the mean
+       count (half floats: 2^-11 relative) */
+    const float *px = NULL;
+    int w, h;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(tmp_path(dir, "out.exr"), &w, &h, (float **)&px, &err), 0, "%s", err.text);
+    cr_assert(w == W && h == H);
+    for (int i = 0; i < W * H; i++)
+        cr_assert(fabs(px[4 * i] - weight[i]) <= 1e-3 * weight[i] + 1e-6,
+                  "pixel %d,%d (%d rows): the picture %g, the rows' weights %g", i % W, i / W, count[i],
+                  px[4 * i], weight[i]);
+    free((float *)px);
+    free(rows);
 }
 
 /* The CSV is complete or absent: a render that fails (here the scene does not parse) leaves a

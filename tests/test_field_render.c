@@ -20,15 +20,19 @@ static const char *SCENE =
     "plane { y, 0 pigment { checker rgb 0.9 rgb 0.1 scale 0.5 } finish { ambient 0.2 diffuse 0.8 } }\n"
     "sphere { <0.3, 0.8, 0.5>, 0.8 pigment { rgb <0.8, 0.2, 0.1> } finish { ambient 0.2 diffuse 0.8 } }\n";
 
+/* The scene at 48 x 36 through the double-Gauss at f/2.8: with pixel or field sampling at 16
+   spp, or "adaptive", field sampling with --adaptive at a mean of 32. */
 static float *render(const char *dir, const char *name, const char *sampling, const char *seed)
 {
     const char *scene = tmp_path(dir, "scene.pov");
     char out[4096];
     snprintf(out, sizeof out, "%s/%s.exr", dir, name);
     char *errtext = NULL;
+    const bool adaptive = !strcmp(sampling, "adaptive");
     int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "48",
-                 "--height", "36", "--spp", "16", "--f-number", "2.8", "--seed", seed, "--sampling",
-                 sampling, "--jobs", "2", "--quiet", "-o", out);
+                 "--height", "36", "--spp", adaptive ? "32" : "16", "--f-number", "2.8", "--seed",
+                 seed, "--sampling", adaptive ? "field" : sampling, "--jobs", "2", "--quiet", "-o",
+                 out, adaptive ? "--adaptive" : "--quiet");
     cr_assert_eq(st, 0, "render %s: %s", name, errtext ? errtext : "");
     free(errtext);
     int w, h;
@@ -56,18 +60,73 @@ static double mean(const float *a)
     return sum / (48 * 36 * 3);
 }
 
-Test(field_render, agrees_with_pixel_sampling_within_the_noise)
+/* A render with `sampling` (render's) against a pixel render of the same film: within the noise
+   between two pixel renders, and unbiased. */
+static void expect_agrees_with_pixel_sampling(const char *sampling)
 {
     const char *dir = test_tmpdir();
     write_text(tmp_path(dir, "scene.pov"), SCENE);
     float *p1 = render(dir, "pixel1", "pixel", "1"), *p2 = render(dir, "pixel2", "pixel", "2");
-    float *f1 = render(dir, "field1", "field", "1");
-    double noise = mean_abs_difference(p1, p2), diff = mean_abs_difference(f1, p1);
-    cr_log_info("field against pixel %.4f, pixel against pixel %.4f; means %.4f %.4f", diff, noise,
-                mean(f1), mean(p1));
-    cr_expect(diff < 1.5 * noise + 2e-3, "field %g, noise %g", diff, noise);
-    cr_expect(fabs(mean(f1) - mean(p1)) < 0.02 * mean(p1));
-    free(p1), free(p2), free(f1);
+    float *f = render(dir, sampling, sampling, "3");
+    double noise = mean_abs_difference(p1, p2), diff = mean_abs_difference(f, p1);
+    cr_log_info("%s against pixel %.4f, pixel against pixel %.4f; means %.4f %.4f", sampling, diff,
+                noise, mean(f), mean(p1));
+    cr_expect(diff < 1.5 * noise + 2e-3, "%s %g, noise %g", sampling, diff, noise);
+    cr_expect(fabs(mean(f) - mean(p1)) < 0.02 * mean(p1));
+    free(p1), free(p2), free(f);
+}
+
+Test(field_render, agrees_with_pixel_sampling_within_the_noise)
+{
+    expect_agrees_with_pixel_sampling("field");
+}
+
+/* --adaptive (src/field/field_adaptive.c): a quarter of the samples over the whole picture,
+   then the rest tile by tile where the error is, each pixel the mean of its tile's. */
+Test(field_render, adaptive_agrees_with_pixel_sampling_within_the_noise)
+{
+    expect_agrees_with_pixel_sampling("adaptive");
+}
+
+/* What --adaptive cannot take: pixel sampling and trace (refused, exit 2, nothing written);
+   POV-Ray's options, whose animations and runs of their own it does not render (refused);
+   fewer than 16 samples or a lens with dispersion (rendered uniformly, with a note). */
+Test(field_render, adaptive_refuses_what_it_cannot_render)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *scene = tmp_path(dir, "scene.pov"), *out = tmp_path(dir, "x.exr");
+    static const struct { const char *extra[3], *message; } bad[] = {
+        {{"--sampling", "pixel", NULL}, "--adaptive is for --sampling field"},
+        {{"--", "+A0.3", NULL}, "--adaptive renders a still without POV-Ray options"}};
+    for (int i = 0; i < 2; i++) {
+        char *errtext = NULL;
+        const int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width",
+                           "16", "--height", "12", "--spp", "16", "--adaptive", "-o", out,
+                           bad[i].extra[0], bad[i].extra[1]);
+        cr_expect_eq(st, 2, "%s: status %d", bad[i].extra[0], st);
+        cr_expect(errtext && strstr(errtext, bad[i].message), "%s", errtext ? errtext : "");
+        cr_expect(!file_exists(out));
+        free(errtext);
+    }
+    char *errtext = NULL;
+    cr_expect_eq(L2P(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--adaptive", "-o",
+                     tmp_path(dir, "t.inc")), 2);
+    cr_expect(errtext && strstr(errtext, "trace does not take --adaptive"), "%s", errtext ? errtext : "");
+    free(errtext);
+    static const struct { const char *lens, *spp, *why; } uniform[] = {
+        {LENS_DIR "dgauss.50mm.dat", "8", "it needs --spp 16 or more"},
+        {LENS_DIR "takumar.50mm.dat", "16", "the lens has dispersion"}};
+    for (int i = 0; i < 2; i++) {
+        errtext = NULL;
+        const int st = L2P(NULL, &errtext, "render", scene, uniform[i].lens, "--width", "16",
+                           "--height", "12", "--spp", uniform[i].spp, "--adaptive", "-o", out);
+        cr_expect_eq(st, 0, "%s: status %d: %s", uniform[i].lens, st, errtext ? errtext : "");
+        cr_expect(errtext && strstr(errtext, uniform[i].why), "%s", errtext ? errtext : "");
+        cr_expect(file_exists(out));
+        remove(out);
+        free(errtext);
+    }
 }
 
 Test(field_render, refuses_a_tolerance_it_cannot_keep)
@@ -161,6 +220,19 @@ Test(field_render, a_render_the_lens_blocks_everywhere_is_black)
     free(px);
 }
 
+/* The two renders' pictures, both w x h, are the same bit for bit. */
+static void expect_same_pictures(char out[2][1024], int w, int h)
+{
+    int pw[2], ph[2];
+    float *px[2];
+    l2p_error err;
+    for (int j = 0; j < 2; j++)
+        cr_assert_eq(image_read_rgba(out[j], &pw[j], &ph[j], &px[j], &err), 0, "%s", err.text);
+    cr_assert(pw[0] == w && ph[0] == h && pw[1] == w && ph[1] == h);
+    cr_expect(memcmp(px[0], px[1], sizeof(float) * 4 * (size_t)w * h) == 0, "the two packings differ");
+    free(px[0]), free(px[1]);
+}
+
 /* How sub-images are packed into renders (here: one render of 4 with one job, two of 2 with
    two) changes no pixel: every UV is a short binary fraction, so every pixel gets the same
    face weights, hence the same ray, in any render. A crop is the crop's size. */
@@ -179,14 +251,35 @@ Test(field_render, packing_changes_no_pixel)
         cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
         free(errtext);
     }
-    int w[2], h[2];
-    float *px[2];
-    l2p_error err;
-    for (int j = 0; j < 2; j++)
-        cr_assert_eq(image_read_rgba(out[j], &w[j], &h[j], &px[j], &err), 0, "%s", err.text);
-    cr_assert(w[0] == 50 && h[0] == 36 && w[1] == 50 && h[1] == 36);
-    cr_expect(memcmp(px[0], px[1], sizeof(float) * 4 * 50 * 36) == 0, "the two packings differ");
-    free(px[0]), free(px[1]);
+    expect_same_pictures(out, 50, 36);
+}
+
+/* The same of --adaptive, whose second round packs pieces of the picture on shelves: with one
+   job, one render a round; with two, more renders than jobs in the second round, so that a
+   POV-Ray run renders several as its frames, each with the rows and columns of the run's
+   first. The tiles' counts come from the first round's picture, which packing does not
+   change, so neither does it change a pixel of the whole. */
+Test(field_render, packing_changes_no_pixel_of_an_adaptive_render)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    const char *scene = tmp_path(dir, "scene.pov");
+    char out[2][1024], work[2][1024];
+    for (int j = 0; j < 2; j++) {
+        snprintf(out[j], sizeof out[j], "%s/jobs%d.exr", dir, j + 1);
+        snprintf(work[j], sizeof work[j], "%s/work%d", dir, j + 1);
+        char *errtext = NULL;
+        int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "fisheye.10mm.dat",
+                     "--width", "96", "--height", "72", "--spp", "32", "--adaptive", "--jobs",
+                     j ? "2" : "1", "--keep-temp", work[j], "--quiet", "-o", out[j]);
+        cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+        free(errtext);
+    }
+    char listing[4096];
+    const int inis = count_entries(work[1], "field.f", listing, sizeof listing) / 3;   /* inc, ini, exr */
+    cr_assert_geq(inis, 5, "two jobs: 2 renders in the first round and more than 2 in the second "
+                  "wanted, found %d: %s", inis, listing);
+    expect_same_pictures(out, 96, 72);
 }
 
 /* The weights, a float a pixel and sub-image, never reach the disk unless the work folder is

@@ -92,7 +92,8 @@ static void free_fixture(fixture *fx)
 
 static povray_options options(const char *scene, const char *work_dir, int jobs)
 {
-    return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL, NULL, false};
+    return (povray_options){scene, work_dir, jobs, 1, 0, NULL, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL, NULL, false,
+                            NULL};
 }
 
 /* The one-chunk table of make_chunks rendered from dir with scene, one job. */

@@ -16,7 +16,8 @@
 # two spp, the ratio taken within each turn; medians.
 #
 # Environment: SIZE (default 96x72), REF_SPP (default 1024), MAX_SPP (the most field sampling
-# tries; default 2048), LENSES (default the four standard lenses).
+# tries; default 2048), LENSES (default the four standard lenses), FIELD_OPTS (options added to
+# every field render, e.g. --adaptive; default none).
 set -eu
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -39,15 +40,17 @@ echo "processor: $(sed -n 's/^model name[^:]*: *//p' /proc/cpuinfo | head -1), $
 
 # render LENS SAMPLING SPP OUTPUT
 render() {
-  # shellcheck disable=SC2086 # $camera is a list of options.
+  opts=''
+  [ "$2" = pixel ] || opts=${FIELD_OPTS:-}
+  # shellcheck disable=SC2086 # $camera and $opts are lists of options.
   "$bin" render "$scene" "lenses/$1.dat" $camera --width "$W" --height "$H" --sampling "$2" \
-      --spp "$3" --quiet -o "$4"
+      --spp "$3" $opts --quiet -o "$4"
 }
 
 # shellcheck disable=SC2086 # plain lens names.
 err_references $lenses
 
-echo "== error against time: field sampling to pixel sampling's $pixel_spp-spp RMSE, $scene, ${W}x$H,"
+echo "== error against time: field sampling${FIELD_OPTS:+ $FIELD_OPTS} to pixel sampling's $pixel_spp-spp RMSE, $scene, ${W}x$H,"
 echo "   against pixel sampling at $ref_spp spp (seed 9001); times are medians of three alternating"
 echo "   runs (pixel $pixel_spp spp, field at the two spp around the crossing), --jobs $(nproc)"
 for l in $lenses; do

@@ -84,6 +84,10 @@ static const cli_option OPTIONS[] = {
      "                                by coarse meshes, or exact rays [field]\n"},
     {"--field-tolerance", NULL, CMD_SAMPLES, false, false,
      "  --field-tolerance PX          field rays' largest error, in pixels [0.05]\n"},
+    {"--adaptive", NULL, CMD_RENDER, true, false,
+     "  --adaptive                    field sampling of a still in two rounds: a quarter\n"
+     "                                of the samples, then more where the error is; spp\n"
+     "                                is the mean [off]\n"},
     {"--keep-temp", NULL, CMD_RENDER, false, false,
      "  --keep-temp DIR               keep the ray tables, renders and logs [removed]\n"},
     {"--quiet", "-q", CMD_TRACE, true, false,
@@ -381,6 +385,11 @@ static int check_contradictions(const cli *c, l2p_error *err)
     if (c->tolerance_given && !c->field_sampling)
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--field-tolerance is for --sampling field; "
                         "pixel sampling traces every ray exactly");
+    if (c->adaptive && !c->field_sampling)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--adaptive is for --sampling field");
+    if (c->adaptive && c->povray_args)
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--adaptive renders a still without POV-Ray "
+                        "options: leave out --adaptive or the options after --");
     if (o->crop_x1 && (o->crop_x1 > o->width || o->crop_y1 > o->height))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--crop %d,%d,%d,%d reaches outside the %dx%d film (X1, Y1 exclusive)",
@@ -397,6 +406,8 @@ static void set_flag(cli *c, const cli_option *o)
         c->quiet = true;
     else if (!strcmp(o->name, "--no-size-check"))
         c->no_size_check = true;
+    else if (!strcmp(o->name, "--adaptive"))
+        c->adaptive = true;
 }
 
 /* The option a word names, for this command; NULL with the error set when the command does not

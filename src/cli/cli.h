@@ -35,6 +35,7 @@ typedef struct cli {
     bool sampling_chosen;        /* --sampling or --field-tolerance given: render keeps to it */
     bool tolerance_given;        /* --field-tolerance: refused with pixel sampling */
     double field_tolerance;      /* --field-tolerance, pixels [0.05] */
+    bool adaptive;               /* --adaptive: a field still in two rounds */
 } cli;
 
 /* Parses argv[first..argc-1] for the command argv[first-1] (info, trace, develop, render, diagram, plot): an

@@ -331,7 +331,8 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
         const povray_options po = {c->positional[0], ws->dir, jobs, cores_online(),
                                    !c->quiet, NULL, chunks_ready, &w, c->povray_args,
                                    c->povray_arg_count, c->cam.width, c->cam.height,
-                                   load_image_library, NULL, frame_picture_done, &d, ws->keep};
+                                   load_image_library, NULL, frame_picture_done, &d, ws->keep,
+                                   NULL};
         if (!st)
             st = povray_render_chunks(pc, count * tf->count, &po, err);
         if (st)
@@ -352,6 +353,19 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     free(d.done), free(d.developed), free(d.exrs);
     free_chunk_list(pc, count * tf->count);
     return st;
+}
+
+/* Whether --adaptive can take this still (fieldtiles.h): its first round needs 4 samples at
+   least, and dispersion deals its wavelength bands over all spp samples, which a tile's first
+   samples would not cover evenly. Else a note, and the still is rendered uniformly. */
+static bool adaptive_fits(const cli *c, const camera *cam)
+{
+    const char *why = cam->samples.spp < 16 ? "it needs --spp 16 or more"
+                      : cam->dispersion    ? "the lens has dispersion" : NULL;
+    if (why && !c->quiet)
+        fprintf(stderr, "lens2pov: note: rendering every pixel with %d samples, since "
+                        "--adaptive cannot take this picture (%s)\n", cam->samples.spp, why);
+    return !why;
 }
 
 /* --sampling field: src/field does the rest for the table's frames, --rays included, which is
@@ -375,8 +389,10 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
     bool too_fine = false;
     const field_render_options fo = {c->positional[0], ws->dir, prefix, fr, tf->count, tf->digits,
                                      c->povray_args, c->povray_arg_count, jobs, cores_online(),
-                                     !c->quiet, c->field_tolerance, with_csv ? csv : NULL,
-                                     &too_fine, load_image_library, ws->keep};
+                                     !c->quiet, c->field_tolerance,
+                                     c->adaptive && adaptive_fits(c, cam),
+                                     with_csv ? csv : NULL, &too_fine, load_image_library,
+                                     ws->keep};
     const int st = field_render(cam, &fo, err);
     free(fr);
     if (st == L2P_BAD_INPUT && too_fine && !c->sampling_chosen) {

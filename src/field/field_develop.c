@@ -11,25 +11,28 @@
 #include "optics/spectrum.h"
 
 /* Adds sub-image k, rendered at (at.dx, at.dy) of a picture of iw pixels a row whose row 0 is
-   not rendered (FS#261, docs/fields.md), into the crop's sums: each pixel its weight times its
-   colour, and with dispersion its band's colour weights. */
+   not rendered (FS#261, docs/fields.md), into the crop's sums: each pixel of its piece (the
+   whole crop unless the map says) its weight times its colour, and with dispersion its band's
+   colour weights. */
 static void add_subimage(const field_map *m, int k, const float *weights, const float *rgba,
                          int iw, double *sums)
 {
     const samplemap_header *h = &m->header;
-    const int w = h->crop_x1 - h->crop_x0, ht = h->crop_y1 - h->crop_y0;
+    const int crop_w = h->crop_x1 - h->crop_x0;
+    const field_piece p = m->piece ? m->piece[k]
+                                   : (field_piece){k, 0, 0, crop_w, h->crop_y1 - h->crop_y0};
     const size_t stride = develop_sums_per_pixel(h);
     double colour[3];
     if (h->wavelength_bands > 0)
         spectrum_band_weights((int)m->band[k], h->wavelength_bands, colour);
     const field_placement *at = &m->at[k];
-    for (int y = 0; y < ht; y++)
-        for (int x = 0; x < w; x++) {
-            const float wt = weights[(size_t)y * w + x];
+    for (int y = 0; y < p.h; y++)
+        for (int x = 0; x < p.w; x++) {
+            const float wt = weights[(size_t)y * p.w + x];
             if (wt <= 0)
                 continue;   /* blocked: no face, black */
             const float *px = rgba + 4 * ((size_t)(at->dy + y + 1) * iw + at->dx + x);
-            develop_add(sums + stride * ((size_t)y * w + x),
+            develop_add(sums + stride * ((size_t)(p.y0 + y) * crop_w + p.x0 + x),
                         h->wavelength_bands > 0 ? colour : NULL, (double)wt, px);
         }
 }
@@ -64,9 +67,9 @@ static void read_pair(picture p[2])
 }
 
 /* Render r's picture and every sub-image in it, in the order of the sub-images. */
-static int add_render(const field_map *m, int r, const picture *p, float *weights, double *sums,
-                      l2p_error *err)
+static int add_render(field_developer *d, int r, const picture *p, l2p_error *err)
 {
+    const field_map *m = d->map;
     if (p->status) {
         *err = p->err;
         return p->status;
@@ -75,9 +78,12 @@ static int add_render(const field_map *m, int r, const picture *p, float *weight
     if (p->width != m->width[r] + 1 || p->height != m->height[r] + 1)
         st = l2p_fail(err, L2P_BAD_INPUT, p->path, 0, "is %dx%d, not %dx%d: not render %d of this "
                       "field map", p->width, p->height, m->width[r] + 1, m->height[r] + 1, r);
-    for (int k = 0; k < m->header.spp && !st; k++)
-        if (m->at[k].render == r && !(st = field_map_weights(m, k, weights, err)))
-            add_subimage(m, k, weights, p->rgba, p->width, sums);
+    for (int k = 0; k < m->subimages && !st; k++)
+        if (m->at[k].render == r && !(st = field_map_weights(m, k, d->weights, err))) {
+            add_subimage(m, k, d->weights, p->rgba, p->width, d->sums);
+            if (k < d->early_count)
+                add_subimage(m, k, d->weights, p->rgba, p->width, d->early);
+        }
     return st;
 }
 
@@ -101,7 +107,7 @@ void field_develop_free(field_developer *d)
 {
     for (int r = 0; d->picture && r < d->map->renders; r++)
         free(d->picture[r]);
-    free(d->picture), free(d->sums), free(d->weights);
+    free(d->picture), free(d->sums), free(d->early), free(d->weights);
     memset(d, 0, sizeof *d);
 }
 
@@ -115,7 +121,7 @@ static int add_known(field_developer *d, l2p_error *err)
         read_pair(p);
         for (int i = 0; i < 2 && p[i].path; i++) {
             if (!st)
-                st = add_render(d->map, r + i, &p[i], d->weights, d->sums, err);
+                st = add_render(d, r + i, &p[i], err);
             if (!st && d->remove_pictures)
                 unlink(p[i].path);
             free(p[i].rgba);
@@ -123,6 +129,15 @@ static int add_known(field_developer *d, l2p_error *err)
         d->next += 1 + two;
     }
     return st;
+}
+
+int field_develop_keep_early(field_developer *d, int count, l2p_error *err)
+{
+    const samplemap_header *h = &d->map->header;
+    const size_t pixels = (size_t)(h->crop_x1 - h->crop_x0) * (size_t)(h->crop_y1 - h->crop_y0);
+    d->early = calloc(develop_sums_per_pixel(h) * pixels, sizeof *d->early);
+    d->early_count = d->early ? count : 0;
+    return d->early ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
 }
 
 int field_develop_add(field_developer *d, int r, const char *path, l2p_error *err)

@@ -18,6 +18,8 @@ int field_develop(const field_map *m, const char *const *renders, int count, con
 typedef struct field_developer {
     const field_map *map;
     double *sums;
+    double *early;      /* the sums of the first early_count sub-images alone, or NULL */
+    int early_count;
     float *weights;
     char **picture;     /* render r's picture once given */
     int next;           /* the first render not yet added */
@@ -25,6 +27,10 @@ typedef struct field_developer {
 } field_developer;
 
 int field_develop_start(field_developer *d, const field_map *m, l2p_error *err);
+
+/* Keeps the sums of the first count sub-images apart too, in d->early (adaptive sampling's
+   first round, fieldtiles.h). L2P_FAILED out of memory. */
+int field_develop_keep_early(field_developer *d, int count, l2p_error *err);
 
 /* Render r's picture is complete at path. L2P_FAILED for a render given twice; errors of
    field_develop. With remove_pictures set (after field_develop_start) the picture is deleted

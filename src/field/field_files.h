@@ -6,6 +6,7 @@
 
 #include "base/outfile.h"
 #include "camera/camera.h"
+#include "field/field_develop.h"
 #include "field/fieldmap.h"
 #include "field/fieldpass.h"
 #include "field/field_render.h"
@@ -32,6 +33,10 @@ typedef struct field_files {
     povray_chunk *chunk;       /* render r's include, ini and picture paths, faces */
     field_render_plan *plans;
     int renders;
+    int subimages;             /* the map's */
+    const field_piece *pieces; /* the request's */
+    camera *piece_camera;      /* with pieces: the camera, narrowed to each as its weights are
+                                  made again (field_piece_crop) */
     field_trace_stats stats;
     bool too_fine;             /* failed: a sub-image the tolerance cannot draw (the message
                                   names --sampling pixel) */
@@ -55,6 +60,14 @@ typedef struct field_files_request {
        again where the pixels pass (fieldpass.h). */
     double weights_kept_bytes;
     bool develops;             /* render's: the table gives the weights; trace's has none */
+    /* What the sub-images show (adaptive sampling's rounds, fieldtiles.h): count of them,
+       sub-image j pieces[j]; pieces NULL: the camera's spp sub-images of the whole crop
+       (count 0). A map file takes whole crops alone. Their strata are dealt for
+       strata_samples (0: the camera's spp). */
+    const field_piece *pieces;
+    int count;
+    int strata_samples;
+    int render_base;           /* the files' first render number: render r is PREFIX.f(base + r) */
 } field_files_request;
 
 /* That cost as POV-Ray is, and as lens2pov runs it, its polls shortened (povray_env.h): the
@@ -69,5 +82,17 @@ typedef struct field_files_request {
 int field_files_make(const camera *c, const field_files_request *q, field_files *out,
                      l2p_error *err);
 void field_files_free(field_files *f);
+
+/* field_povray.c: f's renders through POV-Ray, each job's as the frames of one run, each
+   picture added to dev (started on f's table) as soon as POV-Ray has closed it. */
+int field_render_into(const field_files *f, int jobs, const povray_options *po,
+                      field_developer *dev, l2p_error *err);
+
+/* field_adaptive.c: render's still with adaptive sampling (fieldtiles.h), q its request as
+   for a uniform render (its map file, when asked for, and its CSV are written at the end,
+   of both rounds); the picture goes to out. *too_fine as field_files' of the round that
+   failed. */
+int field_render_adaptive(const camera *c, const field_files_request *q, const povray_options *po,
+                          const char *out, bool *too_fine, l2p_error *err);
 
 #endif

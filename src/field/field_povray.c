@@ -61,7 +61,7 @@ static int assign_jobs(const field_render_plan *plans, int renders, int jobs, in
 /* Develops each render as soon as POV-Ray has closed its picture (povray_options'
    picture_done), so that developing overlaps the frames still rendering and POV-Ray's exit. */
 typedef struct developing {
-    field_developer dev;
+    field_developer *dev;
     const field_files *f;
     const int *order;   /* the run's chunk k is render order[k] */
 } developing;
@@ -71,13 +71,11 @@ static int picture_done(void *ctx, int k, l2p_error *err)
     developing *d = ctx;
     const int r = d->order[k];
     const int st = image_io_ready(err);
-    return st ? st : field_develop_add(&d->dev, r, d->f->chunk[r].output_exr, err);
+    return st ? st : field_develop_add(d->dev, r, d->f->chunk[r].output_exr, err);
 }
 
-/* Each POV-Ray job renders its share of the renders as one animation (assign_jobs); the
-   picture goes to out. */
-static int render_by_jobs(const field_files *f, int jobs, const povray_options *po,
-                          const char *out, l2p_error *err)
+int field_render_into(const field_files *f, int jobs, const povray_options *po,
+                      field_developer *dev, l2p_error *err)
 {
     povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
     int *order = calloc((size_t)f->renders + 1, sizeof *order);
@@ -87,19 +85,29 @@ static int render_by_jobs(const field_files *f, int jobs, const povray_options *
     int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int k = 0; k < f->renders && !st; k++)
         by_job[k] = f->chunk[order[k]];
-    developing d = {.f = f, .order = order};
-    const bool have_dev = !st && !(st = field_develop_start(&d.dev, &f->table, err));
-    d.dev.remove_pictures = !po->work_dir_kept;
+    developing d = {.dev = dev, .f = f, .order = order};
+    dev->remove_pictures = !po->work_dir_kept;
     povray_options with_pictures = *po;
     with_pictures.picture_done = picture_done;
     with_pictures.picture_ctx = &d;
     if (!st)
         st = povray_render_sequences(by_job, frames, n, &with_pictures, err);
-    if (!st)
-        st = field_develop_finish(&d.dev, out, err);
-    if (have_dev)
-        field_develop_free(&d.dev);
     free(by_job), free(order), free(frames);
+    return st;
+}
+
+/* The renders of f, developed into the picture out. */
+static int render_by_jobs(const field_files *f, int jobs, const povray_options *po,
+                          const char *out, l2p_error *err)
+{
+    field_developer dev;
+    int st = field_develop_start(&dev, &f->table, err);
+    if (st)
+        return st;
+    st = field_render_into(f, jobs, po, &dev, err);
+    if (!st)
+        st = field_develop_finish(&dev, out, err);
+    field_develop_free(&dev);
     return st;
 }
 
@@ -196,20 +204,18 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
     if (st)
         return st;
     char library[PATH_MAX + 64];
-    const field_files_request q = {o->prefix, o->jobs, o->tolerance_px,
-                                   o->frames[0].placement ? "Lens2pov_Placement" : NULL,
-                                   o->rays_csv,
-                                   povray_polls_library(library, sizeof library)
-                                       ? FIELD_FRAME_POLLS_S : FIELD_FRAME_S,
-                                   o->work_dir_kept, weights_bytes, true};
-    field_files f;
-    st = field_files_make(c, &q, &f, err);
-    if (o->too_fine)
-        *o->too_fine = f.too_fine;
+    const field_files_request q = {.prefix = o->prefix, .jobs = o->jobs,
+                                   .tolerance_px = o->tolerance_px,
+                                   .placement = o->frames[0].placement ? "Lens2pov_Placement"
+                                                                       : NULL,
+                                   .rays_csv = o->rays_csv,
+                                   .frame_s = povray_polls_library(library, sizeof library)
+                                                  ? FIELD_FRAME_POLLS_S : FIELD_FRAME_S,
+                                   .map_file = o->work_dir_kept,
+                                   .weights_kept_bytes = weights_bytes, .develops = true};
     /* The image library must be there before POV-Ray runs (a file check); render loads it
        once POV-Ray runs (povray_started). */
-    if (!st)
-        st = image_io_present(err);
+    st = image_io_present(err);
     /* The scene sees the film's size as image_width and image_height, as in pixel renders. */
     const povray_options po = {.scene_path = o->scene_path, .work_dir = o->work_dir,
                                .jobs = o->jobs, .threads_per_job = o->threads_per_job,
@@ -218,6 +224,18 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                .started = o->povray_started, .work_dir_kept = o->work_dir_kept,
                                .film_width = c->film.width, .film_height = c->film.height};
     const bool one_run_a_job = !o->povray_args && o->frame_count == 1 && o->frames[0].number < 0;
+    bool too_fine = false;
+    if (!st && o->adaptive && one_run_a_job) {
+        st = field_render_adaptive(c, &q, &po, o->frames[0].output, &too_fine, err);
+        if (o->too_fine)
+            *o->too_fine = too_fine;
+        return st;
+    }
+    field_files f = {0};
+    if (!st)
+        st = field_files_make(c, &q, &f, err);
+    if (o->too_fine)
+        *o->too_fine = f.too_fine;
     povray_chunk *pc = st || one_run_a_job ? NULL : frame_chunks(&f, o);
     if (!st && !one_run_a_job && !pc)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");

@@ -22,7 +22,8 @@
 #include "raytable/povmesh.h"
 
 typedef struct sub {
-    field_mesh mesh;           /* for a render of the crop alone (field_render_size) */
+    field_piece piece;         /* what it shows */
+    field_mesh mesh;           /* for a render of the piece alone (field_render_size) */
     float *weights;            /* one a crop pixel, while building; then in the map's file and
                                   kept (field_pass) */
     uint32_t band;             /* its wavelength band, with dispersion */
@@ -61,39 +62,55 @@ static char *name_of(const char *prefix, int k, const char *ext)
     return s;
 }
 
+/* Builds sub-image k through camera `piece` (a copy of the camera, narrowed here to its
+   piece), its weights into the map's file and kept; on failure *too_fine says whether the
+   tolerance cannot draw it. */
+static int build_one(job *j, int k, camera *piece, bool *too_fine, l2p_error *e)
+{
+    sub *s = &j->subs[k];
+    const int id = s->piece.k;
+    const size_t pixels = (size_t)s->piece.w * s->piece.h;
+    field_piece_crop(j->c, &s->piece, piece);
+    s->weights = malloc(pixels * sizeof *s->weights);
+    film_sample shared = field_shared_sample(j->c, id, &s->band);
+    const double scale = field_strata_place(&j->strata, &shared);
+    int st = s->weights ? field_build_subimage(piece, shared, scale, j->tol, FIELD_COARSEST_CELL,
+                                               &s->mesh, s->weights, &s->stats, e)
+                        : l2p_fail(e, L2P_FAILED, NULL, 0, "out of memory");
+    if (!st && !(s->stats.worst_pixels <= j->tol->pixels))
+        st = l2p_fail(e, L2P_BAD_INPUT, NULL, 0,
+                      "--field-tolerance %g is finer than POV-Ray's float32 rays can hold "
+                      "(sub-image %d): use a larger tolerance or --sampling pixel", j->tol->pixels,
+                      id);
+    if (!st && (size_t)s->stats.faces > pixels)
+        st = l2p_fail(e, L2P_BAD_INPUT, NULL, 0,
+                      "--field-tolerance %g needs %d faces for %zu pixels in sub-image %d: "
+                      "use a larger tolerance or --sampling pixel", j->tol->pixels,
+                      s->stats.faces, pixels, id);
+    *too_fine = st == L2P_BAD_INPUT;   /* the two refusals above */
+    if (!st)
+        field_mesh_shrink(&s->mesh);   /* kept until the renders are written */
+    if (!st && j->map)
+        st = field_map_put_weights(j->map, j->header, k, s->weights, e);
+    if (!st && j->pass)
+        st = field_pass_of(&s->weights, (long long)pixels, shared, scale, j->keep_weights,
+                           &j->pass[k], e);
+    free(s->weights);
+    s->weights = NULL;
+    return st;
+}
+
 static void *build_worker(void *arg)
 {
     job *j = arg;
-    const size_t pixels = (size_t)(j->c->crop_x1 - j->c->crop_x0) * (j->c->crop_y1 - j->c->crop_y0);
+    camera *piece = malloc(sizeof *piece);
+    if (piece)
+        *piece = *j->c;
     for (int k; atomic_load(&j->status) == L2P_OK && (k = atomic_fetch_add(&j->next, 1)) < j->spp;) {
-        sub *s = &j->subs[k];
         l2p_error e;
-        s->weights = malloc(pixels * sizeof *s->weights);
-        film_sample shared = field_shared_sample(j->c, k, &s->band);
-        const double scale = field_strata_place(&j->strata, &shared);
-        int st = s->weights ? field_build_subimage(j->c, shared, scale, j->tol,
-                                                   FIELD_COARSEST_CELL, &s->mesh, s->weights,
-                                                   &s->stats, &e)
-                            : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
-        if (!st && !(s->stats.worst_pixels <= j->tol->pixels))
-            st = l2p_fail(&e, L2P_BAD_INPUT, NULL, 0,
-                          "--field-tolerance %g is finer than POV-Ray's float32 rays can hold "
-                          "(sub-image %d): use a larger tolerance or --sampling pixel", j->tol->pixels, k);
-        if (!st && (size_t)s->stats.faces > pixels)
-            st = l2p_fail(&e, L2P_BAD_INPUT, NULL, 0,
-                          "--field-tolerance %g needs %d faces for %zu pixels in sub-image %d: "
-                          "use a larger tolerance or --sampling pixel", j->tol->pixels,
-                          s->stats.faces, pixels, k);
-        const bool too_fine = st == L2P_BAD_INPUT;   /* the two refusals above */
-        if (!st)
-            field_mesh_shrink(&s->mesh);   /* kept until the renders are written */
-        if (!st && j->map)
-            st = field_map_put_weights(j->map, j->header, k, s->weights, &e);
-        if (!st && j->pass)
-            st = field_pass_of(&s->weights, (long long)pixels, shared, scale, j->keep_weights,
-                               &j->pass[k], &e);
-        free(s->weights);
-        s->weights = NULL;
+        bool too_fine = false;
+        const int st = piece ? build_one(j, k, piece, &too_fine, &e)
+                             : l2p_fail(&e, L2P_FAILED, NULL, 0, "out of memory");
         if (st) {
             pthread_mutex_lock(&j->lock);
             if (atomic_load(&j->status) == L2P_OK) {
@@ -104,6 +121,7 @@ static void *build_worker(void *arg)
             pthread_mutex_unlock(&j->lock);
         }
     }
+    free(piece);
     return NULL;
 }
 
@@ -253,6 +271,70 @@ static int pack(sub *subs, int spp, int w, int h, int jobs, double frame_s,
     return renders;
 }
 
+/* The faces a render of pieces takes: with R renders of F faces each out of all, over P
+   pixels, the frames' overhead R frame_s / jobs and the face search P F SEARCH_S (as
+   cost_per_sub weighs them) add up least at F = sqrt(all frame_s / (jobs P SEARCH_S)); as
+   many renders as that needs, rounded up to a multiple of the jobs, share the faces
+   equally, at most FIELD_FACES_PER_RENDER each. */
+static long long faces_per_render(long long all, double pixels, int jobs, double frame_s)
+{
+    const double best = sqrt(all * frame_s / (jobs * fmax(pixels, 1.0) * SEARCH_S));
+    const double renders = ceil(all / fmax(best, 1.0) / jobs) * jobs;
+    const long long each = (long long)ceil(all / renders);
+    return each < 1 ? 1 : each < FIELD_FACES_PER_RENDER ? each : FIELD_FACES_PER_RENDER;
+}
+
+/* Pieces (adaptive sampling's second round, taller first: field_tiles_pieces) on shelves,
+   left to right across a render as wide as the crop's, each shelf as tall as its first piece;
+   a render takes pieces up to faces_per_render and to a height that shares the pieces'
+   pixels equally; every render has the size and the rendered rows and columns of the
+   largest (assign_jobs runs a job's renders as the frames of one POV-Ray run). Returns the
+   number of renders. */
+static int pack_shelves(sub *subs, int n, int crop_w, int jobs, double frame_s,
+                        field_render_plan *plans)
+{
+    long long all = 0;
+    double pixels = 0.0;
+    for (int k = 0; k < n; k++)
+        all += subs[k].stats.faces, pixels += (double)subs[k].piece.w * subs[k].piece.h;
+    const long long each = faces_per_render(all, pixels, jobs, frame_s);
+    const int width = field_render_size(crop_w);
+    /* the renders' height: their share of the pieces' pixels, a tenth more for what the
+       shelves leave, or the tallest piece; every render is rendered to the tallest */
+    const double renders = ceil((double)all / each);
+    const double share = ceil(1.1 * pixels / renders / width);
+    const double highest = FIELD_PIXELS_PER_RENDER / (width + 1.0) - 1;
+    const int high = (int)fmin(fmax(share, n > 0 ? subs[0].piece.h : 1), highest);
+    int r = -1, x = 0, y = 0, shelf = 0, tallest = 0;
+    for (int k = 0; k < n; k++) {
+        const field_piece *p = &subs[k].piece;
+        const long long faces = subs[k].stats.faces;
+        if (x + p->w > width)   /* the next shelf */
+            y += shelf, x = 0, shelf = 0;
+        if (r < 0 || (plans[r].faces > 0 && plans[r].faces + faces > each) || y + p->h > high) {
+            plans[++r] = (field_render_plan){.first = k};
+            x = y = shelf = 0;
+        }
+        subs[k].at = (field_placement){r, x, y};
+        x += p->w;
+        shelf = p->h > shelf ? p->h : shelf;
+        field_render_plan *pl = &plans[r];
+        pl->count++, pl->faces += faces;
+        pl->used_width = x > pl->used_width ? x : pl->used_width;
+        pl->used_height = y + shelf > pl->used_height ? y + shelf : pl->used_height;
+        tallest = pl->used_height > tallest ? pl->used_height : tallest;
+    }
+    /* a POV-Ray run renders all its frames with the first one's rows and columns */
+    int widest = 0;
+    for (int i = 0; i <= r; i++)
+        widest = plans[i].used_width > widest ? plans[i].used_width : widest;
+    for (int i = 0; i <= r; i++) {
+        plans[i].width = width, plans[i].height = field_render_size(tallest);
+        plans[i].used_width = widest, plans[i].used_height = tallest;
+    }
+    return r + 1;
+}
+
 /* ---------------------------------------------------------------- files */
 
 /* Mesh space (camera space less the front vertex, mm) to the world: POV-Ray's matrix rows are
@@ -367,14 +449,16 @@ static int write_ini(const field_render_plan *p, const char *exr, outfile *f, l2
 
 /* --rays: written once the sub-images have their renders, before POV-Ray runs, so that a
    disk too full for it fails at once; the caller renames it into place on success. */
-static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l2p_error *err)
+static int write_rays(const camera *c, const sub *subs, int spp, int strata_samples,
+                      const field_piece *pieces, outfile *csv, l2p_error *err)
 {
     field_placement *at = malloc(sizeof *at * (size_t)spp);
     if (!at)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int k = 0; k < spp; k++)
         at[k] = subs[k].at;
-    int st = field_rays_write(csv->fp, csv->final_path, c, at, spp, err);
+    int st = field_rays_write(csv->fp, csv->final_path, c, strata_samples, pieces, NULL, at, spp,
+                              err);
     free(at);
     return st ? st : outfile_finish(csv, err);
 }
@@ -383,7 +467,10 @@ static int write_rays(const camera *c, const sub *subs, int spp, outfile *csv, l
 static int weights_again(const void *ctx, int k, float *weights, l2p_error *err)
 {
     const field_files *f = ctx;
-    return field_pass_weights(f->camera, &f->pass[k], weights, err);
+    if (!f->pieces)
+        return field_pass_weights(f->camera, &f->pass[k], weights, err);
+    field_piece_crop(f->camera, &f->pieces[k], f->piece_camera);
+    return field_pass_weights(f->piece_camera, &f->pass[k], weights, err);
 }
 
 /* The map's tables: each render's size, each sub-image's place and band; into the file too
@@ -391,21 +478,25 @@ static int weights_again(const void *ctx, int k, float *weights, l2p_error *err)
 static int finish_map(const camera *c, const sub *subs, const field_render_plan *plans, int renders,
                       field_files *f, l2p_error *err)
 {
-    const int spp = c->samples.spp;
+    const int spp = f->subimages;
     field_map *m = &f->table;
     *m = (field_map){.renders = renders, .weights_of = f->pass ? weights_again : NULL,
                      .weights_ctx = f};
     povmesh_camera_header(c, &m->header);
+    m->header.spp = m->subimages = spp;
     m->width = malloc(sizeof *m->width * (size_t)renders);
     m->height = malloc(sizeof *m->height * (size_t)renders);
     m->at = malloc(sizeof *m->at * (size_t)spp);
     m->band = malloc(sizeof *m->band * (size_t)spp);
-    int st = m->width && m->height && m->at && m->band ? L2P_OK
+    m->piece = f->pieces ? malloc(sizeof *m->piece * (size_t)spp) : NULL;
+    int st = m->width && m->height && m->at && m->band && (m->piece || !f->pieces) ? L2P_OK
              : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int r = 0; !st && r < renders; r++)
         m->width[r] = plans[r].width, m->height[r] = plans[r].height;
     for (int k = 0; !st && k < spp; k++)
         m->at[k] = subs[k].at, m->band[k] = subs[k].band;
+    for (int k = 0; !st && m->piece && k < spp; k++)
+        m->piece[k] = subs[k].piece;
     if (!st && f->map_path)
         st = field_map_finish(&f->map, m, err);
     return st;
@@ -417,7 +508,7 @@ void field_files_free(field_files *f)
 {
     outfile_discard(&f->map);
     field_map_free(&f->table);
-    for (int k = 0; f->pass && k < f->camera->samples.spp; k++)
+    for (int k = 0; f->pass && k < f->subimages; k++)
         field_pass_free(&f->pass[k]);
     free(f->pass);
     for (int r = 0; r < f->renders; r++) {
@@ -426,6 +517,7 @@ void field_files_free(field_files *f)
         free((char *)f->chunk[r].output_exr);
     }
     free(f->inc), free(f->ini), free(f->chunk), free(f->map_path), free(f->plans);
+    free(f->piece_camera);
     memset(f, 0, sizeof *f);
 }
 
@@ -447,7 +539,9 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     if (!(tolerance_px > 0) || !isfinite(tolerance_px))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--field-tolerance must be a number of pixels "
                         "above 0 (for exact rays, use --sampling pixel)");
-    const int spp = c->samples.spp, w = c->crop_x1 - c->crop_x0, h = c->crop_y1 - c->crop_y0;
+    const int spp = q->pieces ? q->count : c->samples.spp;
+    if (q->pieces && q->map_file)
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "a field map file takes whole crops alone");
     const int jobs = q->jobs > 0 ? q->jobs : 1;
     const char *prefix = q->prefix;
     field_tolerance tol;
@@ -458,14 +552,28 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     field_render_plan *plans = calloc((size_t)spp, sizeof *plans);
     char *map_path = q->map_file ? malloc(strlen(prefix) + 8) : NULL;
     out->camera = c;
+    out->subimages = spp;
+    out->pieces = q->pieces;
+    out->piece_camera = q->pieces ? malloc(sizeof *out->piece_camera) : NULL;
+    if (out->piece_camera)
+        *out->piece_camera = *c;
     out->pass = q->develops ? calloc((size_t)spp, sizeof *out->pass) : NULL;
     *subs_out = subs;
-    if (!subs || !plans || (q->develops && !out->pass) || (q->map_file && !map_path)) {
+    if (!subs || !plans || (q->develops && !out->pass) || (q->map_file && !map_path) ||
+        (q->pieces && !out->piece_camera)) {
         free(plans), free(map_path);
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
-    for (int k = 0; k < spp; k++)
-        field_mesh_init(&subs[k].mesh, field_render_size(w), field_render_size(h));
+    /* every sub-image has a slot of the largest piece's size in its render */
+    const int crop_w = c->crop_x1 - c->crop_x0, crop_h = c->crop_y1 - c->crop_y0;
+    int w = 1, h = 1;
+    for (int k = 0; k < spp; k++) {
+        subs[k].piece = q->pieces ? q->pieces[k] : (field_piece){k, 0, 0, crop_w, crop_h};
+        w = subs[k].piece.w > w ? subs[k].piece.w : w;
+        h = subs[k].piece.h > h ? subs[k].piece.h : h;
+        field_mesh_init(&subs[k].mesh, field_render_size(subs[k].piece.w),
+                        field_render_size(subs[k].piece.h));
+    }
     int st = L2P_OK;
     if (map_path) {
         sprintf(map_path, "%s.map", prefix);
@@ -476,7 +584,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     job j = {.c = c, .map = map_path ? &out->map : NULL, .header = &header, .pass = out->pass,
              .keep_weights = 4.0 * spp * w * h <= q->weights_kept_bytes, .tol = &tol,
              .subs = subs, .spp = spp};
-    field_strata_count(c, &j.strata);
+    field_strata_count(c, q->strata_samples > 0 ? q->strata_samples : c->samples.spp, &j.strata);
     atomic_init(&j.next, 0);
     atomic_init(&j.status, L2P_OK);
     pthread_mutex_init(&j.lock, NULL);
@@ -484,7 +592,9 @@ static int build_files(const camera *c, const field_files_request *q, field_file
         st = build_all(&j, jobs, err);
     out->too_fine = st && j.too_fine;
     pthread_mutex_destroy(&j.lock);
-    const int renders = st ? 0 : pack(subs, spp, w, h, jobs, q->frame_s, plans);
+    const int renders = st          ? 0
+                        : q->pieces ? pack_shelves(subs, spp, crop_w, jobs, q->frame_s, plans)
+                                    : pack(subs, spp, w, h, jobs, q->frame_s, plans);
     if (!st)
         st = finish_map(c, subs, plans, renders, out, err);
     if (!st)
@@ -496,9 +606,10 @@ static int build_files(const camera *c, const field_files_request *q, field_file
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int r = 0; r < renders && !st; r++, out->renders++) {
         povray_chunk *ch = &out->chunk[r];
-        *ch = (povray_chunk){.include_path = name_of(prefix, r, "inc"),
-                             .ini_path = name_of(prefix, r, "ini"),
-                             .output_exr = name_of(prefix, r, "exr"), .faces = plans[r].faces};
+        const int named = q->render_base + r;
+        *ch = (povray_chunk){.include_path = name_of(prefix, named, "inc"),
+                             .ini_path = name_of(prefix, named, "ini"),
+                             .output_exr = name_of(prefix, named, "exr"), .faces = plans[r].faces};
         if (!ch->include_path || !ch->ini_path || !ch->output_exr)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
         if (!st && !(st = outfile_open(&out->ini[r], ch->ini_path, err)))
@@ -527,16 +638,18 @@ int field_files_make(const camera *c, const field_files_request *q, field_files 
     memset(out, 0, sizeof *out);   /* also when build_files refuses the tolerance first */
     int st = build_files(c, q, out, &subs, err);
     if (!st && q->rays_csv)
-        st = write_rays(c, subs, c->samples.spp, q->rays_csv, err);
+        st = write_rays(c, subs, out->subimages,
+                        q->strata_samples > 0 ? q->strata_samples : c->samples.spp, q->pieces,
+                        q->rays_csv, err);
     if (!st)
         st = files_commit(out, err);
     out->stats.renders = out->renders;
-    for (int k = 0; !st && k < c->samples.spp; k++) {
+    for (int k = 0; !st && k < out->subimages; k++) {
         out->stats.faces += subs[k].stats.faces;
         out->stats.passed += subs[k].stats.passed;
         out->stats.pixels += subs[k].stats.passed + subs[k].stats.blocked;
     }
-    subs_free(subs, c->samples.spp);
+    subs_free(subs, out->subimages);
     return st;
 }
 
@@ -544,8 +657,9 @@ int field_trace(const camera *c, const field_trace_options *o, field_trace_stats
                 l2p_error *err)
 {
     /* the renders are for the user's POV-Ray, whose polls are as they are */
-    const field_files_request q = {o->prefix, o->jobs, o->tolerance_px, NULL, o->rays_csv,
-                                   FIELD_FRAME_S, true, 0, false};
+    const field_files_request q = {.prefix = o->prefix, .jobs = o->jobs,
+                                   .tolerance_px = o->tolerance_px, .rays_csv = o->rays_csv,
+                                   .frame_s = FIELD_FRAME_S, .map_file = true};
     field_files f;
     const int st = field_files_make(c, &q, &f, err);
     *stats = f.stats;

@@ -12,6 +12,12 @@ void field_pixel_raster(const camera *c, film_sample s, long i, double *rx, doub
     *ry = c->crop_y0 + i / w + s.offset_y;
 }
 
+void field_piece_crop(const camera *c, const field_piece *p, camera *out)
+{
+    out->crop_x0 = c->crop_x0 + p->x0, out->crop_y0 = c->crop_y0 + p->y0;
+    out->crop_x1 = out->crop_x0 + p->w, out->crop_y1 = out->crop_y0 + p->h;
+}
+
 film_sample field_shared_sample(const camera *c, int k, uint32_t *band)
 {
     film_sample s = sobol_shared_sample(c->samples.seed, (uint32_t)k);

@@ -7,6 +7,12 @@
 
 #include <stdint.h>
 #include "camera/camera.h"
+#include "field/fieldrays.h"
+
+/* Narrows *out, a copy of camera c, to piece p: its crop becomes the piece's rectangle of
+   c's, for all that takes a sub-image's pixels from the camera's crop. (A camera is large:
+   copied once, narrowed for each piece.) */
+void field_piece_crop(const camera *c, const field_piece *p, camera *out);
 
 /* Pixel i of the crop (row by row: i = y * crop width + x) seen with shared sample s: its
    raster position, (crop_x0 + x + offset_x, crop_y0 + y + offset_y). */

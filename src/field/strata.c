@@ -86,13 +86,13 @@ static int ring_samples(int p, double share, bool margin_only)
     return (int)(k < least ? least : k > p - 1 ? p - 1 : k);
 }
 
-void field_strata_count(const camera *c, field_strata *out)
+void field_strata_count(const camera *c, int samples, field_strata *out)
 {
     *out = (field_strata){.on = false};
     sample_batch *b = malloc(sizeof *b);
     /* the stop pupil and thick tracing fit no region (every sample passes the axis or none
        is known to); one sample cannot be split */
-    const int n = c->samples.spp;
+    const int n = samples;
     const bool fitted = (c->pupil.kind == PUPIL_STOP_IMAGE || c->pupil.kind == PUPIL_REAR) &&
                         pupil_is_fitted(&c->pupil);
     if (!b || !fitted || n < 2) {

@@ -17,9 +17,10 @@ typedef struct field_strata {
     int core_count, ring_count;   /* how many of the shared samples go to each stratum */
 } field_strata;
 
-/* Measures the core on camera c's axis and deals its spp shared samples (field_shared_sample)
-   to the strata. */
-void field_strata_count(const camera *c, field_strata *out);
+/* Measures the core on camera c's axis and deals the first `samples` shared samples
+   (field_shared_sample) to the strata: camera c's spp, or adaptive sampling's first round,
+   whose every later block of as many (a power of two) is dealt alike. */
+void field_strata_count(const camera *c, int samples, field_strata *out);
 
 /* The core's radius on the unit disk at this wavelength (any, without dispersion). */
 double field_strata_core_radius(const field_strata *t, double nm);

@@ -59,6 +59,9 @@ typedef struct povray_options {
     void *picture_ctx;
     bool work_dir_kept;        /* work_dir outlives the run (--keep-temp): a message may name a
                                   log there; else it quotes the log's last line */
+    /* The run's files in work_dir: NAME.sNNN.pov, NAME.sNNN.log, ...; NULL: "povray". Runs
+       into one folder take names of their own, so that a kept folder holds every log. */
+    const char *file_name;
 } povray_options;
 
 /* Writes, for every chunk, a wrapper that includes the scene and then the chunk's camera, and

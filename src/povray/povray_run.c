@@ -160,7 +160,9 @@ int povray_run_prepare(run *r, const povray_chunk *chunks, int count, const int 
     if ((frames && !r->first) || !r->reported)
         return povray_out_of_memory(err);
     r->work_dir = absolute_path(opts->work_dir);
-    r->chunk_prefix = r->work_dir ? str_printf("%s/povray", r->work_dir) : NULL;
+    r->chunk_prefix = r->work_dir ? str_printf("%s/%s", r->work_dir,
+                                               opts->file_name ? opts->file_name : "povray")
+                                  : NULL;
     if (!r->jobs || !r->chunk_prefix)
         return povray_out_of_memory(err);
     int st = check_plain(r->work_dir, err);
