@@ -8,17 +8,11 @@
 #include "camera/camera.h"
 #include "field/field_develop.h"
 #include "field/fieldmap.h"
+#include "field/fieldpack.h"
 #include "field/fieldpass.h"
 #include "field/field_render.h"
 #include "povray/povray.h"
 
-/* One POV-Ray render: its final size (POV-Ray renders one more each way) and sub-images. */
-typedef struct field_render_plan {
-    int width, height;
-    int used_width, used_height;   /* the grid of sub-images, from the top left: rendered */
-    int first, count;
-    long long faces;
-} field_render_plan;
 
 /* The outputs, under temporary names until committed. */
 typedef struct field_files {
@@ -51,7 +45,7 @@ typedef struct field_files_request {
     const char *placement;
     outfile *rays_csv;         /* --rays: written and finished, not committed; NULL: none */
     /* What a render costs POV-Ray beyond its pixels, as a frame of a run (seconds): what the
-       packing weighs against the face search (field_render.c, cost_per_sub). */
+       packing weighs against the face search (fieldpack.c, cost_per_sub). */
     double frame_s;
     /* Whether PREFIX.map is written with every sub-image's weights (trace's, and render's
        when its work folder is kept, for develop); render itself develops from the table. */

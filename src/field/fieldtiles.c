@@ -129,7 +129,7 @@ static long rectangles(const field_tiles *t, int k, unsigned char *used, field_p
     return n;
 }
 
-/* Taller pieces first, then wider (the shelves they are packed on, field_render.c), then in
+/* Taller pieces first, then wider (the shelves they are packed on, fieldpack.c), then in
    their order. */
 static int taller_first(const void *a, const void *b)
 {

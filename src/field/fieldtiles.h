@@ -17,7 +17,7 @@ enum { FIELD_TILE_PX = 8 };
 enum { FIELD_TILE_MOST_ROUNDS = 16 };
 
 /* The most tiles a piece of the second round spans from top to bottom: the renders of pieces
-   all have the height of the tallest (field_render.c, pack_shelves), so one piece as tall as
+   all have the height of the tallest (fieldpack.c, field_pack_shelves), so one piece as tall as
    the crop would make every render that tall. */
 enum { FIELD_PIECE_TILES_HIGH = 4 };
 
