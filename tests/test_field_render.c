@@ -89,7 +89,7 @@ Test(field_render, adaptive_agrees_with_pixel_sampling_within_the_noise)
 }
 
 /* What --adaptive cannot take: pixel sampling and trace (refused, exit 2, nothing written);
-   POV-Ray's options, whose animations and runs of their own it does not render (refused);
+   POV-Ray's animation options, whose frames would each need tiles of their own (refused);
    fewer than 16 samples or a lens with dispersion (rendered uniformly, with a note). */
 Test(field_render, adaptive_refuses_what_it_cannot_render)
 {
@@ -98,7 +98,8 @@ Test(field_render, adaptive_refuses_what_it_cannot_render)
     const char *scene = tmp_path(dir, "scene.pov"), *out = tmp_path(dir, "x.exr");
     static const struct { const char *extra[3], *message; } bad[] = {
         {{"--sampling", "pixel", NULL}, "--adaptive is for --sampling field"},
-        {{"--", "+A0.3", NULL}, "--adaptive renders a still without POV-Ray options"}};
+        {{"--", "+KFF3", NULL}, "--adaptive renders a still, but POV-Ray's options after -- make "
+                                "an animation of 3 frames"}};
     for (int i = 0; i < 2; i++) {
         char *errtext = NULL;
         const int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width",
@@ -279,6 +280,53 @@ Test(field_render, packing_changes_no_pixel_of_an_adaptive_render)
     const int inis = count_entries(work[1], "field.f", listing, sizeof listing) / 3;   /* inc, ini, exr */
     cr_assert_geq(inis, 5, "two jobs: 2 renders in the first round and more than 2 in the second "
                   "wanted, found %d: %s", inis, listing);
+    expect_same_pictures(out, 96, 72);
+}
+
+/* A still's POV-Ray options with --adaptive: every render of both rounds is a POV-Ray run of
+   its own (a stand-in notes each run's arguments), each run is given the options, and the
+   picture is, bit for bit, the one rendered without them when they change nothing in it (a
+   Declare= the scene does not read): the runs are developed as the animation loop's frames
+   are. */
+Test(field_render, adaptive_passes_a_stills_povray_options_to_every_render)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "scene.pov"), SCENE);
+    char scene[1024], work[1024], script[1024], text[2048], out[2][1024];
+    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
+    snprintf(work, sizeof work, "%s/work", dir);
+    snprintf(script, sizeof script, "%s/argspov", dir);
+    snprintf(text, sizeof text, "#!/bin/sh\necho \"$*\" >> '%s/runs'\nexec povray \"$@\"\n", dir);
+    write_text(script, text);
+    chmod(script, 0755);
+    for (int j = 0; j < 2; j++) {
+        snprintf(out[j], sizeof out[j], "%s/options%d.exr", dir, j);
+        char *errtext = NULL;
+        if (j)
+            setenv("LENS2POV_POVRAY", script, 1);
+        int st = L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "96",
+                     "--height", "72", "--spp", "32", "--adaptive", "--jobs", "2", "--quiet",
+                     "--keep-temp", j ? work : tmp_path(dir, "plain"), "-o", out[j],
+                     j ? "--" : NULL, "Declare=Lens2povUnread=1");
+        unsetenv("LENS2POV_POVRAY");
+        cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+        free(errtext);
+    }
+    char listing[8192];
+    const int renders = count_entries(work, "field.f", listing, sizeof listing) / 3;   /* inc, ini, exr */
+    const int second = count_entries(work, "povray.r2.", NULL, 0) / 2;   /* wrapper, log */
+    cr_assert_geq(second, 2, "the second round's runs: %d (%s)", second, listing);
+    char *runs = read_text(tmp_path(dir, "runs"), NULL);
+    cr_assert_not_null(runs);
+    int lines = 0, with = 0;   /* the renders' runs, not the probe of the scene's camera */
+    for (char *line = strtok(runs, "\n"); line; line = strtok(NULL, "\n"))
+        if (strstr(line, "/field.f")) {
+            lines++;
+            with += strstr(line, "Declare=Lens2povUnread=1") != NULL;
+        }
+    free(runs);
+    cr_expect_eq(lines, renders, "a POV-Ray run a render: %d runs, %d renders", lines, renders);
+    cr_expect_eq(with, lines, "%d of %d runs had the option", with, lines);
     expect_same_pictures(out, 96, 72);
 }
 

@@ -387,9 +387,6 @@ static int check_contradictions(const cli *c, l2p_error *err)
                         "pixel sampling traces every ray exactly");
     if (c->adaptive && !c->field_sampling)
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--adaptive is for --sampling field");
-    if (c->adaptive && c->povray_args)
-        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--adaptive renders a still without POV-Ray "
-                        "options: leave out --adaptive or the options after --");
     if (o->crop_x1 && (o->crop_x1 > o->width || o->crop_y1 > o->height))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--crop %d,%d,%d,%d reaches outside the %dx%d film (X1, Y1 exclusive)",

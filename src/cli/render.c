@@ -432,10 +432,15 @@ static int render_table(const render_frames *rf, int t, const workspace *ws, int
     return st;
 }
 
-/* Every frame's picture can be written: checked before any work (without POV-Ray's options
-   the one picture was checked with the other inputs). */
-static int check_frame_outputs(const cli *c, const render_frames *rf, l2p_error *err)
+/* Before any work: every frame's picture can be written (without POV-Ray's options the one
+   picture was checked with the other inputs), and --adaptive has a still, since its tiles
+   follow one picture's error. */
+static int check_frames(const cli *c, const render_frames *rf, l2p_error *err)
 {
+    if (c->adaptive && (rf->count > 1 || rf->frame[0].number >= 0))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--adaptive renders a still, but POV-Ray's "
+                        "options after -- make an animation of %d frame%s: leave out --adaptive "
+                        "or the animation options", rf->count, rf->count == 1 ? "" : "s");
     int st = L2P_OK;
     for (int i = 0; !st && c->povray_args && i < rf->count; i++)
         st = outfile_check_path(rf->frame[i].output, err);
@@ -459,7 +464,7 @@ int render_command(const cli *given, l2p_error *err)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     resolved.povray_args = args;
     render_frames rf;
-    if ((st = render_frames_plan(c, &rf, err)) || (st = check_frame_outputs(c, &rf, err))) {
+    if ((st = render_frames_plan(c, &rf, err)) || (st = check_frames(c, &rf, err))) {
         render_frames_free(&rf);
         povargs_free(args);
         return st;

@@ -12,9 +12,12 @@
 #include "field/subimage.h"
 #include "raytable/raytable.h"
 
-/* What a POV-Ray process takes with an empty scene, and what developing keeps a film pixel in
-   (its sums), besides the faces. */
+/* What a POV-Ray process takes with an empty scene; what render takes before any work, the
+   image library loaded (OpenImageIO and the libraries it brings: about 131 MiB resident for a
+   16x12 film), through every phase; and what developing keeps a film pixel in (its sums),
+   besides the faces. */
 #define POVRAY_BASE_BYTES (16.0 * 1048576.0)
+#define RENDER_BASE_BYTES (160.0 * 1048576.0)
 #define DEVELOP_BYTES_PER_PIXEL 32.0
 
 static void crop_size(const camera_options *o, int *w, int *h)
@@ -44,7 +47,7 @@ static void render_sizes(const cli *c, double faces, double pixels, int jobs, si
     const double povray = at_once * e->povray_process_bytes;
     const double develop = faces * SIZE_MAP_BYTES_PER_FACE + chunk_faces * 16.0 +
                            pixels * DEVELOP_BYTES_PER_PIXEL;
-    e->memory_bytes = povray > develop ? povray : develop;
+    e->memory_bytes = RENDER_BASE_BYTES + (povray > develop ? povray : develop);
 }
 
 static size_estimate pixel_estimate(const cli *c, int jobs)
@@ -133,7 +136,7 @@ static void field_memory(const field_layout *l, int jobs, size_estimate *e)
     const double povray = l->at_once * e->povray_process_bytes;
     const double develop = l->pixels * (DEVELOP_BYTES_PER_PIXEL + sizeof(float)) +
                            l->render_pixels * 4 * sizeof(float);
-    e->memory_bytes = meshes + kept + fmax(build, fmax(povray, develop));
+    e->memory_bytes = RENDER_BASE_BYTES + meshes + kept + fmax(build, fmax(povray, develop));
 }
 
 /* The workspace holds each render's include and ini (and POV-Ray's wrapper scene and log: at

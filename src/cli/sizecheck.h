@@ -46,7 +46,8 @@ typedef struct size_estimate {
     double csv_bytes;             /* --rays, 0 without */
     double renders_bytes;         /* render: the chunks' (field: the renders') EXR files, and
                                      POV-Ray's state files of the renders at once */
-    double memory_bytes;          /* render: POV-Ray's processes at once, or lens2pov's own work */
+    double memory_bytes;          /* render: lens2pov itself, and POV-Ray's processes at once
+                                     or lens2pov's own work */
     double povray_process_bytes;  /* render: one POV-Ray process, at most */
     bool csv_in_workspace;        /* the CSV is written in the workspace, then moved to --rays */
 } size_estimate;

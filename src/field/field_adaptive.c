@@ -24,7 +24,8 @@ static int first_round(int spp)
     return n;
 }
 
-/* One round: its files built, rendered and developed. */
+/* One round: its files built, rendered and developed, onto sums when given (an earlier
+   round's, which this one then owns, also when it fails). */
 typedef struct render_round {
     field_files files;
     field_developer dev;
@@ -32,10 +33,12 @@ typedef struct render_round {
 } render_round;
 
 static int run_round(const camera *c, const field_files_request *q, const povray_options *po,
-                     int early, render_round *r, l2p_error *err)
+                     int early, double *sums, render_round *r, l2p_error *err)
 {
     int st = field_files_make(c, q, &r->files, err);
-    if (!st && !(st = field_develop_start(&r->dev, &r->files.table, err)))
+    if (st)
+        free(sums);
+    else if (!(st = field_develop_continue(&r->dev, &r->files.table, sums, err)))
         r->started = true;
     if (!st && early)
         st = field_develop_keep_early(&r->dev, early, err);
@@ -48,27 +51,23 @@ static void round_free(render_round *r)
 {
     if (r->started)
         field_develop_free(&r->dev);
+    r->started = false;
     field_files_free(&r->files);
 }
 
-/* The picture: each pixel's sums over both rounds, scaled to the picture's spp. */
-static int write_picture(const render_round *one, const render_round *two, const field_tiles *t,
+/* The picture from the sums of both rounds, each pixel's scaled in place to the picture's
+   spp. */
+static int write_picture(double *sums, const samplemap_header *h, const field_tiles *t,
                          const char *out, l2p_error *err)
 {
     const long pixels = (long)t->width * t->height;
-    double *sums = malloc(sizeof *sums * 3 * (size_t)pixels);
-    if (!sums)
-        return l2p_fail(err, L2P_FAILED, out, 0, "out of memory");
+    const size_t stride = develop_sums_per_pixel(h);
     for (long i = 0; i < pixels; i++)
-        for (int ch = 0; ch < 3; ch++) {
-            const size_t at = 3 * (size_t)i + ch;
-            sums[at] = (one->dev.sums[at] + (two ? two->dev.sums[at] : 0.0)) * field_tiles_scale(t, i);
-        }
-    samplemap map = {.header = one->files.table.header};
+        for (size_t ch = 0; ch < stride; ch++)
+            sums[stride * (size_t)i + ch] *= field_tiles_scale(t, i);
+    samplemap map = {.header = *h};
     map.header.spp = t->spp;
-    const int st = develop_write_picture(&map, sums, out, err);
-    free(sums);
-    return st;
+    return develop_write_picture(&map, sums, out, err);
 }
 
 /* Both rounds as one map: render r of the second round numbered after the first's, its
@@ -164,9 +163,14 @@ int field_render_adaptive(const camera *c, const field_files_request *q, const p
     const int spp = c->samples.spp, first = first_round(spp);
     struct timespec begun;
     clock_gettime(CLOCK_REALTIME, &begun);
+    /* The CSV and the kept map list both rounds, so the first round's files stay to the end,
+       and the rounds share the memory kept for weights (fieldpass.h); else the first round's
+       go once it is developed. */
+    const bool listed = q->rays_csv || q->map_file;
     field_files_request q1 = *q;
     q1.pieces = NULL, q1.count = 0, q1.strata_samples = first;
     q1.map_file = false, q1.rays_csv = NULL;
+    q1.weights_kept_bytes = listed ? q->weights_kept_bytes / 2 : q->weights_kept_bytes;
     render_round one = {0}, two = {0};
     field_tiles t = {0};
     field_piece *pieces = NULL;
@@ -176,7 +180,7 @@ int field_render_adaptive(const camera *c, const field_files_request *q, const p
     if (!st) {
         *c1 = *c;
         c1->samples.spp = first;
-        st = run_round(c1, &q1, po, first / 2, &one, err);
+        st = run_round(c1, &q1, po, first / 2, NULL, &one, err);
         *too_fine = one.files.too_fine;
     }
     if (!st)
@@ -185,20 +189,31 @@ int field_render_adaptive(const camera *c, const field_files_request *q, const p
     const long n2 = st ? 0 : field_tiles_pieces(&t, first, &pieces);
     if (n2 < 0)
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    /* The second round adds onto the first's sums; of the first, only its files, listed, stay. */
+    const samplemap_header header = one.files.table.header;
+    const int first_renders = one.files.renders;
+    double *sums = one.started ? field_develop_take_sums(&one.dev) : NULL;
+    if (one.started)
+        field_develop_free(&one.dev), one.started = false;
+    if (!listed)
+        field_files_free(&one.files);
     const bool second = !st && n2 > 0;
     if (second) {
         field_files_request q2 = q1;
         q2.pieces = pieces, q2.count = (int)n2;
-        q2.render_base = one.files.renders;
+        q2.render_base = first_renders;
         povray_options po2 = *po;
         po2.file_name = "povray.r2";   /* the first round's logs stay */
-        st = run_round(c, &q2, &po2, 0, &two, err);
+        st = run_round(c, &q2, &po2, 0, sums, &two, err);
+        sums = two.started ? two.dev.sums : NULL;
         *too_fine = two.files.too_fine;
     }
     if (!st)
-        st = write_picture(&one, second ? &two : NULL, &t, out, err);
+        st = write_picture(sums, &header, &t, out, err);
+    if (!second)
+        free(sums);
     joined j = {0};
-    if (!st && (q->rays_csv || q->map_file))
+    if (!st && listed)
         st = join(&one, second ? &two : NULL, &t, &j, err);
     if (!st && q->rays_csv)
         st = write_rays(c, &j, q->rays_csv, err);

@@ -87,13 +87,13 @@ static int add_render(field_developer *d, int r, const picture *p, l2p_error *er
     return st;
 }
 
-int field_develop_start(field_developer *d, const field_map *m, l2p_error *err)
+int field_develop_continue(field_developer *d, const field_map *m, double *sums, l2p_error *err)
 {
     memset(d, 0, sizeof *d);
     d->map = m;
     const samplemap_header *h = &m->header;
     const size_t pixels = (size_t)(h->crop_x1 - h->crop_x0) * (size_t)(h->crop_y1 - h->crop_y0);
-    d->sums = calloc(develop_sums_per_pixel(h) * pixels, sizeof *d->sums);
+    d->sums = sums ? sums : calloc(develop_sums_per_pixel(h) * pixels, sizeof *d->sums);
     d->weights = malloc(sizeof *d->weights * pixels);
     d->picture = calloc((size_t)m->renders + 1, sizeof *d->picture);
     if (!d->sums || !d->weights || !d->picture) {
@@ -101,6 +101,18 @@ int field_develop_start(field_developer *d, const field_map *m, l2p_error *err)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
     return L2P_OK;
+}
+
+int field_develop_start(field_developer *d, const field_map *m, l2p_error *err)
+{
+    return field_develop_continue(d, m, NULL, err);
+}
+
+double *field_develop_take_sums(field_developer *d)
+{
+    double *sums = d->sums;
+    d->sums = NULL;
+    return sums;
 }
 
 void field_develop_free(field_developer *d)

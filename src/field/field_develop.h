@@ -28,6 +28,14 @@ typedef struct field_developer {
 
 int field_develop_start(field_developer *d, const field_map *m, l2p_error *err);
 
+/* The same, adding onto sums of m's crop (3 a pixel, or develop_sums_per_pixel's) that an
+   earlier developer gave up (field_develop_take_sums): adaptive sampling's second round goes
+   on with its first's picture. d owns them from the call on, also when it fails. */
+int field_develop_continue(field_developer *d, const field_map *m, double *sums, l2p_error *err);
+
+/* d's sums, which the caller then owns (d keeps none; free it as usual). */
+double *field_develop_take_sums(field_developer *d);
+
 /* Keeps the sums of the first count sub-images apart too, in d->early (adaptive sampling's
    first round, fieldtiles.h). L2P_FAILED out of memory. */
 int field_develop_keep_early(field_developer *d, int count, l2p_error *err);

@@ -77,8 +77,9 @@ int field_files_make(const camera *c, const field_files_request *q, field_files 
                      l2p_error *err);
 void field_files_free(field_files *f);
 
-/* field_povray.c: f's renders through POV-Ray, each job's as the frames of one run, each
-   picture added to dev (started on f's table) as soon as POV-Ray has closed it. */
+/* field_povray.c: f's renders through POV-Ray, each job's as the frames of one run (with
+   po's user_args, a still's POV-Ray options: each render a run of its own), each picture
+   added to dev (started on f's table) as soon as POV-Ray has closed it. */
 int field_render_into(const field_files *f, int jobs, const povray_options *po,
                       field_developer *dev, l2p_error *err);
 

@@ -77,11 +77,18 @@ static int picture_done(void *ctx, int k, l2p_error *err)
 int field_render_into(const field_files *f, int jobs, const povray_options *po,
                       field_developer *dev, l2p_error *err)
 {
+    /* With POV-Ray's options (a still's: Declare=, +Q, ...) the animation loop is not
+       lens2pov's to use: a run a render, in render order. */
+    const bool runs = po->user_arg_count > 0;
     povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
     int *order = calloc((size_t)f->renders + 1, sizeof *order);
     int *frames = calloc((size_t)f->renders + 1, sizeof *frames);
-    const int n = !by_job || !order || !frames
-                      ? -1 : assign_jobs(f->plans, f->renders, jobs > 0 ? jobs : 1, order, frames);
+    int n = -1;
+    if (by_job && order && frames && runs)
+        for (n = 0; n < f->renders; n++)
+            order[n] = n;
+    else if (by_job && order && frames)
+        n = assign_jobs(f->plans, f->renders, jobs > 0 ? jobs : 1, order, frames);
     int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int k = 0; k < f->renders && !st; k++)
         by_job[k] = f->chunk[order[k]];
@@ -90,7 +97,9 @@ int field_render_into(const field_files *f, int jobs, const povray_options *po,
     povray_options with_pictures = *po;
     with_pictures.picture_done = picture_done;
     with_pictures.picture_ctx = &d;
-    if (!st)
+    if (!st && runs)
+        st = povray_render_chunks(by_job, f->renders, &with_pictures, err);
+    else if (!st)
         st = povray_render_sequences(by_job, frames, n, &with_pictures, err);
     free(by_job), free(order), free(frames);
     return st;
@@ -223,9 +232,10 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                .user_arg_count = o->povray_arg_count,
                                .started = o->povray_started, .work_dir_kept = o->work_dir_kept,
                                .film_width = c->film.width, .film_height = c->film.height};
-    const bool one_run_a_job = !o->povray_args && o->frame_count == 1 && o->frames[0].number < 0;
+    const bool still = o->frame_count == 1 && o->frames[0].number < 0;
+    const bool one_run_a_job = !o->povray_args && still;
     bool too_fine = false;
-    if (!st && o->adaptive && one_run_a_job) {
+    if (!st && o->adaptive && still) {
         st = field_render_adaptive(c, &q, &po, o->frames[0].output, &too_fine, err);
         if (o->too_fine)
             *o->too_fine = too_fine;

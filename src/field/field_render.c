@@ -400,8 +400,10 @@ static int build_files(const camera *c, const field_files_request *q, field_file
     /* every sub-image has a slot of the largest piece's size in its render */
     const int crop_w = c->crop_x1 - c->crop_x0, crop_h = c->crop_y1 - c->crop_y0;
     int w = 1, h = 1;
+    double pixels = 0;   /* the sub-images' in all */
     for (int k = 0; k < spp; k++) {
         subs[k].piece = q->pieces ? q->pieces[k] : (field_piece){k, 0, 0, crop_w, crop_h};
+        pixels += (double)subs[k].piece.w * subs[k].piece.h;
         w = subs[k].piece.w > w ? subs[k].piece.w : w;
         h = subs[k].piece.h > h ? subs[k].piece.h : h;
         field_mesh_init(&subs[k].mesh, field_render_size(subs[k].piece.w),
@@ -415,7 +417,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
             st = field_map_begin(&out->map, &header, err);
     }
     job j = {.c = c, .map = map_path ? &out->map : NULL, .header = &header, .pass = out->pass,
-             .keep_weights = 4.0 * spp * w * h <= q->weights_kept_bytes, .tol = &tol,
+             .keep_weights = 4.0 * pixels <= q->weights_kept_bytes, .tol = &tol,
              .subs = subs, .spp = spp};
     field_strata_count(c, q->strata_samples > 0 ? q->strata_samples : c->samples.spp, &j.strata);
     atomic_init(&j.next, 0);

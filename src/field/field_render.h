@@ -30,8 +30,8 @@ typedef struct field_render_options {
     int threads_per_job;       /* +WTn; 0: POV-Ray's default */
     bool progress;
     double tolerance_px;       /* --field-tolerance */
-    /* --adaptive: a still without POV-Ray options in two rounds, spp the mean (fieldtiles.h);
-       the caller leaves it off with dispersion. */
+    /* --adaptive: a still (one frame, not an animation's) in two rounds, spp the mean
+       (fieldtiles.h); the caller leaves it off with dispersion. */
     bool adaptive;
     outfile *rays_csv;         /* --rays: opened by the caller, written and finished here, not
                                   committed; NULL: none */
