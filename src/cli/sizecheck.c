@@ -112,7 +112,7 @@ static field_layout field_layout_of(const cli *c, int jobs)
 }
 
 /* lens2pov keeps every sub-image's mesh until the renders are written: a face (field_mesh's
-   tri) and a vertex (pos, nrm, pix, uv) a face, a margin over the half as many vertices as
+   tri) and a vertex (pos, nrm, pix) a face, a margin over the half as many vertices as
    faces of a triangulated grid, and SIZE_FIELD_BYTES_PER_SUBIMAGE; and until it is developed,
    its weights (fieldpass.h): a float a pixel while all of them fit FIELD_WEIGHTS_KEPT_MB (or
    the environment's bound), else where its pixels pass, four runs a row of the crop (more
@@ -122,7 +122,7 @@ static field_layout field_layout_of(const cli *c, int jobs)
    sub-image's weights, a render's picture as float RGBA). */
 static void field_memory(const field_layout *l, int jobs, size_estimate *e)
 {
-    const double mesh_face = 3 * sizeof(int) + 6 * sizeof(float) + 4 * sizeof(double);
+    const double mesh_face = 3 * sizeof(int) + 6 * sizeof(float) + 2 * sizeof(double);
     const double weights = l->spp * l->pixels * sizeof(float);
     const double runs = l->spp * 4 * l->rows * 2 * sizeof(long long);
     double bound;

@@ -14,7 +14,7 @@ void field_mesh_init(field_mesh *m, int render_w, int render_h)
 
 void field_mesh_free(field_mesh *m)
 {
-    free(m->pos), free(m->nrm), free(m->pix), free(m->uv), free(m->tri);
+    free(m->pos), free(m->nrm), free(m->pix), free(m->tri);
     memset(m, 0, sizeof *m);
 }
 
@@ -44,9 +44,6 @@ int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double x, double y)
     if (grow((void **)&m->nrm, &cap, need, sizeof *m->nrm) < 0)
         return -1;
     cap = m->vertex_cap;
-    if (grow((void **)&m->uv, &cap, need, sizeof *m->uv) < 0)
-        return -1;
-    cap = m->vertex_cap;
     if (grow((void **)&m->pix, &cap, need, sizeof *m->pix) < 0)
         return -1;
     m->vertex_cap = cap;
@@ -54,10 +51,15 @@ int field_mesh_vertex(field_mesh *m, vec3 pos, vec3 nrm, double x, double y)
     m->pos[k][0] = (float)pos.x, m->pos[k][1] = (float)pos.y, m->pos[k][2] = (float)pos.z;
     m->nrm[k][0] = (float)nrm.x, m->nrm[k][1] = (float)nrm.y, m->nrm[k][2] = (float)nrm.z;
     m->pix[k][0] = x, m->pix[k][1] = y;
-    /* povuv_pixel_uv for a position that need not be whole */
-    m->uv[k][0] = x / (m->render_w + 1);
-    m->uv[k][1] = 1.0 - (y + 1) / (m->render_h + 1);
     return k;
+}
+
+/* Vertex i's UV: povuv_pixel_uv for a position that need not be whole. Made when needed, not
+   kept: a mesh is held until its render is written, and its vertices are most of it. */
+static void uv_of(const field_mesh *m, int i, double uv[2])
+{
+    uv[0] = m->pix[i][0] / (m->render_w + 1);
+    uv[1] = 1.0 - (m->pix[i][1] + 1) / (m->render_h + 1);
 }
 
 /* An array of at least n elements of size cut to n: a failed realloc leaves the block as it
@@ -74,7 +76,6 @@ void field_mesh_shrink(field_mesh *m)
     fit((void **)&m->pos, m->vertices, sizeof *m->pos);
     fit((void **)&m->nrm, m->vertices, sizeof *m->nrm);
     fit((void **)&m->pix, m->vertices, sizeof *m->pix);
-    fit((void **)&m->uv, m->vertices, sizeof *m->uv);
     fit((void **)&m->tri, m->faces, sizeof *m->tri);
     if (m->pos)
         m->vertex_cap = m->vertices;
@@ -149,7 +150,7 @@ void field_mesh_povuv_face(const field_mesh *m, int k, povuv_face *f)
         int i = m->tri[k][j];
         for (int c = 0; c < 3; c++)
             pos[j][c] = m->pos[i][c], nrm[j][c] = m->nrm[i][c];
-        uv[j][0] = m->uv[i][0], uv[j][1] = m->uv[i][1];
+        uv_of(m, i, uv[j]);
     }
     povuv_face_init(f, pos, nrm, uv);
 }
@@ -181,8 +182,11 @@ int field_mesh_write_include(FILE *out, const field_mesh *m, const char *name, c
     for (int i = 0; i < m->vertices; i++)
         fprintf(out, ",\n<%.9g,%.9g,%.9g>", m->nrm[i][0], m->nrm[i][1], m->nrm[i][2]);
     fprintf(out, " }\n  uv_vectors { %d", m->vertices);
-    for (int i = 0; i < m->vertices; i++)
-        fprintf(out, ",\n<%.17g,%.17g>", m->uv[i][0], m->uv[i][1]);
+    for (int i = 0; i < m->vertices; i++) {
+        double uv[2];
+        uv_of(m, i, uv);
+        fprintf(out, ",\n<%.17g,%.17g>", uv[0], uv[1]);
+    }
     fprintf(out, " }\n  face_indices { %d", m->faces);
     for (int i = 0; i < m->faces; i++)
         fprintf(out, ",\n<%d,%d,%d>", m->tri[i][0], m->tri[i][1], m->tri[i][2]);

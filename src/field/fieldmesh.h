@@ -11,8 +11,8 @@ typedef struct field_mesh {
     int vertex_cap, face_cap;
     float (*pos)[3];      /* mesh space: camera space minus the lens's front vertex, mm */
     float (*nrm)[3];      /* ray directions, as written (POV-Ray normalizes them again) */
-    double (*pix)[2];     /* the vertex's place in the final picture of the render, pixels */
-    double (*uv)[2];      /* from pix by povuv_pixel_uv: dyadic, exact in the file */
+    double (*pix)[2];     /* the vertex's place in the final picture of the render, pixels;
+                             its UV (povuv_pixel_uv) is dyadic, exact in the file */
     int (*tri)[3];
     int render_w, render_h;   /* the final picture of the render (POV-Ray renders one more) */
 } field_mesh;
