@@ -1,9 +1,9 @@
-/* render --adaptive: a still's field render in two rounds (docs/fields.md, "Adaptive
-   sampling"). The first renders a quarter of the samples over the whole crop and measures each
-   tile's error; the second renders the further sub-images each tile is given, over those
-   tiles only. Every count is a multiple of the first round's, a power of two whose every block
-   of sub-images holds the same share of each stratum (strata.c), so that each pixel's weights
-   stay those of a uniform render of its tile's count. */
+/* render --adaptive: a still's field render in two rounds (docs/adaptive.md). The first
+   renders a quarter of the samples over the whole crop and measures each tile's error; the
+   second renders the further sub-images each tile is given, over those tiles only. Every
+   count is a multiple of the first round's, a power of two whose every block of sub-images
+   holds the same share of each stratum (strata.c), so that each pixel's weights stay those
+   of a uniform render of its tile's count. */
 #include "field/field_files.h"
 
 #include <errno.h>

@@ -1,4 +1,4 @@
-/* Adaptive field sampling's tiles (docs/fields.md, "Adaptive sampling"): the crop in squares of
+/* Adaptive field sampling's tiles (docs/adaptive.md): the crop in squares of
    FIELD_TILE_PX pixels, each with its own count of shared samples: a first round renders the
    whole crop with the first of them, and a second renders the rest, each sample over
    rectangles of the tiles whose count is above it (pieces, fieldrays.h). A pixel is the mean
