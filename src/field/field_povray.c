@@ -63,13 +63,13 @@ static int assign_jobs(const field_render_plan *plans, int renders, int jobs, in
 typedef struct developing {
     field_developer *dev;
     const field_files *f;
-    const int *order;   /* the run's chunk k is render order[k] */
+    const int *order;   /* the run's chunk k is render order[k]; NULL: render k */
 } developing;
 
 static int picture_done(void *ctx, int k, l2p_error *err)
 {
     developing *d = ctx;
-    const int r = d->order[k];
+    const int r = d->order ? d->order[k] : k;
     const int st = image_io_ready(err);
     return st ? st : field_develop_add(d->dev, r, d->f->chunk[r].output_exr, err);
 }
@@ -77,29 +77,25 @@ static int picture_done(void *ctx, int k, l2p_error *err)
 int field_render_into(const field_files *f, int jobs, const povray_options *po,
                       field_developer *dev, l2p_error *err)
 {
-    /* With POV-Ray's options (a still's: Declare=, +Q, ...) the animation loop is not
-       lens2pov's to use: a run a render, in render order. */
-    const bool runs = po->user_arg_count > 0;
-    povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
-    int *order = calloc((size_t)f->renders + 1, sizeof *order);
-    int *frames = calloc((size_t)f->renders + 1, sizeof *frames);
-    int n = -1;
-    if (by_job && order && frames && runs)
-        for (n = 0; n < f->renders; n++)
-            order[n] = n;
-    else if (by_job && order && frames)
-        n = assign_jobs(f->plans, f->renders, jobs > 0 ? jobs : 1, order, frames);
-    int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int k = 0; k < f->renders && !st; k++)
-        by_job[k] = f->chunk[order[k]];
-    developing d = {.dev = dev, .f = f, .order = order};
+    developing d = {.dev = dev, .f = f};
     dev->remove_pictures = !po->work_dir_kept;
     povray_options with_pictures = *po;
     with_pictures.picture_done = picture_done;
     with_pictures.picture_ctx = &d;
-    if (!st && runs)
-        st = povray_render_chunks(by_job, f->renders, &with_pictures, err);
-    else if (!st)
+    /* With POV-Ray's options (a still's: Declare=, +Q, ...) the animation loop is not
+       lens2pov's to use: a run a render, in render order. */
+    if (po->user_arg_count > 0)
+        return povray_render_chunks(f->chunk, f->renders, &with_pictures, err);
+    povray_chunk *by_job = calloc((size_t)f->renders + 1, sizeof *by_job);
+    int *order = calloc((size_t)f->renders + 1, sizeof *order);
+    int *frames = calloc((size_t)f->renders + 1, sizeof *frames);
+    const int n = !by_job || !order || !frames
+                      ? -1 : assign_jobs(f->plans, f->renders, jobs > 0 ? jobs : 1, order, frames);
+    int st = n > 0 ? L2P_OK : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int k = 0; k < f->renders && !st; k++)
+        by_job[k] = f->chunk[order[k]];
+    d.order = order;
+    if (!st)
         st = povray_render_sequences(by_job, frames, n, &with_pictures, err);
     free(by_job), free(order), free(frames);
     return st;
