@@ -428,3 +428,15 @@ int system_povray(const char *command)
     }
     return status;
 }
+
+double json_number(const char *json, const char *key)
+{
+    char quoted[128];
+    snprintf(quoted, sizeof quoted, "\"%s\":", key);
+    const char *p = strstr(json, quoted);
+    cr_assert_not_null(p, "info --json has no %s:\n%s", key, json);
+    char *end;
+    const double v = strtod(p + strlen(quoted), &end);
+    cr_assert(end != p + strlen(quoted), "%s is not a number", key);
+    return v;
+}

@@ -51,6 +51,10 @@ char *read_text(const char *path, size_t *length);
 
 bool file_exists(const char *path);
 
+/* A number of `lens2pov info --json`'s output, "key": value; fails the test when there is
+   none. */
+double json_number(const char *json, const char *key);
+
 /* Removes a folder under /tmp with everything in it. */
 void remove_tree(const char *dir);
 

@@ -66,15 +66,6 @@ static void read_claim(const char *path, double *focal_mm, double *f_number)
     free(text);
 }
 
-/* A number of `info --json`'s output: "key": value. */
-static double json_number(const char *json, const char *key)
-{
-    char quoted[64];
-    snprintf(quoted, sizeof quoted, "\"%s\": ", key);
-    const char *p = strstr(json, quoted);
-    cr_assert_not_null(p, "no %s in: %s", key, json);
-    return strtod(p + strlen(quoted), NULL);
-}
 
 static const char *base_name(const char *path)
 {

@@ -66,20 +66,6 @@ static bool exists(const char *path)
     return stat(path, &s) == 0;
 }
 
-/* Entries of a folder other than . and ..; names starting with prefix when prefix is given. */
-/* A number from `lens2pov info --json`. */
-static double json_number(const char *json, const char *key)
-{
-    char quoted[128];
-    snprintf(quoted, sizeof quoted, "\"%s\":", key);
-    const char *p = strstr(json, quoted);
-    cr_assert_not_null(p, "info --json has no %s:\n%s", key, json);
-    char *end;
-    const double v = strtod(p + strlen(quoted), &end);
-    cr_assert(end != p + strlen(quoted), "%s is not a number", key);
-    return v;
-}
-
 /* A fresh folder (test_tmpdir's buffer is reused by its next call) and paths in it. */
 #define NEW_DIR(d) char d[64]; snprintf(d, sizeof d, "%s", test_tmpdir())
 #define PATH(var, dir, name) char var[512]; snprintf(var, sizeof var, "%s/%s", dir, name)

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-#include "cli/info.h"
+#include "camera/fieldangle.h"
 #include "povray/scenecam.h"
 
 int framing_from_scene(cli *c, const char *scene, l2p_error *err)
@@ -41,18 +41,6 @@ void framing_apply(cli *c, const scene_camera *s)
         c->angle_deg = sc.hfov_deg;
 }
 
-/* The film half width, mm, at which the horizontal half field of cam is half_deg: bisection
-   between 0 and hi, where the field is at least that. */
-static double half_width_for(const camera *cam, double half_deg, double hi)
-{
-    double lo = 0.0;
-    for (int k = 0; k < 200 && hi - lo > 1e-15 * hi; k++) {
-        const double mid = 0.5 * (lo + hi);
-        *(info_half_field_deg(cam, v3(mid, 0, 0)) < half_deg ? &lo : &hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-}
-
 static int setup_with_diagonal(camera *cam, const lens *l, const cli *c, double diagonal_mm,
                                l2p_error *err)
 {
@@ -67,41 +55,53 @@ static int setup_with_diagonal(camera *cam, const lens *l, const cli *c, double 
     return st;
 }
 
-/* The pupil region is fitted up to the film's corner, so the chief rays, and the field, move a
-   little with the film's size: the film is sized again on each camera until it settles. */
+/* The film half width, mm, at which the horizontal half field of f is half_deg:
+   bisection between 0 and hi, where it is at least that. The field angle grows with the film
+   radius up to the image circle and stays there. */
+static double half_width_for(const field_angles *f, double half_deg, double hi)
+{
+    double lo = 0.0;
+    for (int k = 0; k < 200 && hi - lo > 1e-15 * hi; k++) {
+        const double mid = 0.5 * (lo + hi);
+        *(field_angles_half_deg(f, mid) < half_deg ? &lo : &hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* The field angle belongs to the lens and its focus, not to the film (camera/fieldangle.h): it is measured
+   on a camera whose film reaches beyond anything the lens passes, where the pupil's reach is
+   the image circle, and the film is then sized to it. */
 static int solve_film(camera *cam, const lens *l, const cli *c, l2p_error *err)
 {
+    memset(cam, 0, sizeof *cam);   /* freeable on failure, as camera_setup leaves it */
     const double aspect = (double)c->cam.height / (double)c->cam.width;
     const double per_half_width = 2.0 * sqrt(1.0 + aspect * aspect);
     const double half_deg = 0.5 * c->angle_deg;
     double widest = 0.0;
     for (int i = 0; i < l->count; i++)
         widest = fmax(widest, l->surface[i].aperture_diameter_mm);
-    /* Beyond a few times the widest element the lens passes nothing: the field is its
-       image circle's there. */
-    double x = 4.0 * widest;
-    int st = setup_with_diagonal(cam, l, c, per_half_width * x, err);
+    /* Beyond a few times the widest element the lens passes nothing. */
+    const double x = 4.0 * widest;
+    camera wide;
+    int st = setup_with_diagonal(&wide, l, c, per_half_width * x, err);
     if (st)
         return st;
-    const double most = info_half_field_deg(cam, v3(x, 0, 0));
-    if (!(most >= half_deg)) {
-        camera_free(cam);
-        return l2p_fail(err, L2P_BAD_INPUT, l->path, 0,
-                        "--angle %g: this lens sees at most %.4g degrees across (at its focus "
-                        "in effect)", c->angle_deg, 2.0 * most);
+    field_angles f;
+    if (field_angles_open(&f, &wide)) {
+        camera_free(&wide);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
-    for (int round = 0; round < 8; round++) {
-        const double next = half_width_for(cam, half_deg, round ? 2.0 * x : x);
-        camera_free(cam);
-        st = setup_with_diagonal(cam, l, c, per_half_width * next, err);
-        if (st)
-            return st;
-        const bool settled = fabs(next - x) <= 1e-12 * x;
-        x = next;
-        if (settled)
-            break;
-    }
-    return L2P_OK;
+    const double most = field_angles_half_deg(&f, x);
+    double half_width = NAN;
+    if (!(most >= half_deg))
+        st = l2p_fail(err, L2P_BAD_INPUT, l->path, 0,
+                      "--angle %g: this lens sees at most %.4g degrees across (at its focus "
+                      "in effect)", c->angle_deg, 2.0 * most);
+    else
+        half_width = half_width_for(&f, half_deg, x);
+    field_angles_close(&f);
+    camera_free(&wide);
+    return st ? st : setup_with_diagonal(cam, l, c, per_half_width * half_width, err);
 }
 
 int framing_camera_setup(camera *cam, lens *l, const cli *c, l2p_error *err)

@@ -21,8 +21,9 @@ void framing_warn_perturbed(const char *scene, bool perturbed);
 void framing_apply(cli *c, const scene_camera *sc);
 
 /* camera_setup for the command line: with --angle, the film diagonal that makes the lens's
-   horizontal field of view, traced with real rays at the focus in effect, the angle asked
-   (the film keeps its aspect); L2P_BAD_INPUT when the lens cannot reach it. Takes the lens. */
+   horizontal field of view (camera/fieldangle.h: its chief rays at the focus in effect) the
+   angle asked (the film keeps its aspect); L2P_BAD_INPUT when it lies beyond the image circle.
+   Takes the lens. */
 int framing_camera_setup(camera *cam, lens *l, const cli *c, l2p_error *err);
 
 /* framing_camera_setup of the lens found by name or path (cli/lens_lookup.h). */

@@ -3,6 +3,7 @@
 #include "cli/commands.h"
 #include "cli/framing.h"
 #include "cli/lens_lookup.h"
+#include "camera/fieldangle.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -44,26 +45,14 @@ int lens_info_of(const lens *src, lens_info *out, l2p_error *err)
     return st;
 }
 
-/* Half field angle, degrees: the ray from film point p through the middle of the pupil region
-   sampled for it, traced out of the lens. Where the lens passes nothing from p (beyond a
-   fisheye's image circle) the field ends at the image circle: the film point is moved toward
-   the centre, by bisection, to the last place its ray passes. NAN when even the centre's is
-   blocked. */
 double info_half_field_deg(const camera *c, vec3 p)
 {
-    ray r;
-    double w, in = 1.0, out = 1.0;
-    if (!camera_trace(c, p, 0.5, 0.5, &r, &w)) {
-        if (!camera_trace(c, v3(0, 0, 0), 0.5, 0.5, &r, &w))
-            return NAN;
-        in = 0.0;
-        for (int k = 0; k < 60; k++) {
-            const double mid = 0.5 * (in + out);
-            *(camera_trace(c, v3_scale(p, mid), 0.5, 0.5, &r, &w) ? &in : &out) = mid;
-        }
-        camera_trace(c, v3_scale(p, in), 0.5, 0.5, &r, &w);
-    }
-    return acos(fmin(1.0, r.d.z)) * 180.0 / M_PI;
+    field_angles f;
+    if (field_angles_open(&f, c))
+        return NAN;
+    const double deg = field_angles_half_deg(&f, hypot(p.x, p.y));
+    field_angles_close(&f);
+    return deg;
 }
 
 /* The image-side f-number at the focus in effect, N_w = 1 / (2 n' sin theta'), paraxially
@@ -120,6 +109,9 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,
             {"aperture_f_number", "f-number (this aperture)", "", c->f_number},
             {"working_f_number", "working f-number (paraxial)", "", info_working_f_number(c)},
             {"aperture_diameter_mm", "aperture diameter", "mm", c->lens.stop_diameter_mm},
+            {"film_width_mm", "film width", "mm", fi->width_mm},
+            {"film_height_mm", "film height", "mm", fi->height_mm},
+            {"film_diagonal_mm", "film diagonal", "mm", fi->diagonal_mm},
             {"hfov_deg", "horizontal field of view", "deg", 2 * info_half_field_deg(c, v3(0.5 * fi->width_mm, 0, 0))},
             {"vfov_deg", "vertical field of view", "deg", 2 * info_half_field_deg(c, v3(0, 0.5 * fi->height_mm, 0))},
             {"dfov_deg", "diagonal field of view", "deg", 2 * info_half_field_deg(c, v3(0.5 * fi->width_mm, 0.5 * fi->height_mm, 0))},

@@ -16,9 +16,8 @@ typedef struct lens_info {
 /* First-order properties of the lens at its full stop, independent of the film distance. */
 int lens_info_of(const lens *l, lens_info *out, l2p_error *err);
 
-/* Half field angle, degrees, of film point p: its ray through the middle of the pupil region
-   sampled for it, traced out of the lens; beyond a fisheye's image circle, the circle's. NAN
-   when even the centre's ray is blocked. */
+/* Half field angle, degrees, of film point p: field_angles_half_deg (camera/fieldangle.h) at
+   its distance from the axis. */
 double info_half_field_deg(const camera *c, vec3 p);
 
 /* The working (image-side) f-number at the camera's focus and aperture, paraxial; NAN when the

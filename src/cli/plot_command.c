@@ -81,11 +81,14 @@ static int write_table(const plot_job *j, bool vignetting, l2p_error *err)
     FILE *f = fopen(path_in(j, "table.dat"), "w");
     if (!f)
         return l2p_fail(err, L2P_FAILED, j->dir, 0, "cannot write the table");
+    int st = L2P_OK;
     if (vignetting)
         plot_vignetting_table(f, j->cam_ptr, j->count);
     else
-        plot_distortion_table(f, j->cam_ptr[0]);
-    return fclose(f) ? l2p_fail(err, L2P_FAILED, j->dir, 0, "cannot write the table") : L2P_OK;
+        st = plot_distortion_table(f, j->cam_ptr[0], err);
+    if (fclose(f) && !st)
+        st = l2p_fail(err, L2P_FAILED, j->dir, 0, "cannot write the table");
+    return st;
 }
 
 /* The lens's name in the chart's title, without what gnuplot's quoted strings would take as

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "base/cleanup.h"
+#include "camera/fieldangle.h"
 #include "optics/irradiance.h"
 #include "optics/pupil.h"
 
@@ -16,25 +17,23 @@ static double film_radius(const camera *c, int row)
     return 0.5 * c->film.diagonal_mm * row / (PLOT_ROWS - 1);
 }
 
-/* The chief ray's angle to the axis: from film point (0, r) through the middle of the pupil
-   region sampled there (as info measures the field of view). */
-static bool chief_angle(const camera *c, double r, double *theta)
+/* The field angle of film radius r (camera/fieldangle.h), inside the reach of c's pupil
+   (beyond a fisheye's image circle the lens images nothing). */
+static bool imaged_angle(const field_angles *f, double r, double *theta)
 {
-    ray out;
-    double w;
-    if (!camera_trace(c, v3(0, r, 0), 0.5, 0.5, &out, &w))
-        return false;
-    *theta = atan2(hypot(out.d.x, out.d.y), out.d.z);
-    return true;
+    return r <= f->camera->pupil.reach_mm && field_angles_ray(f, r, theta);
 }
 
-void plot_distortion_table(FILE *out, const camera *c)
+int plot_distortion_table(FILE *out, const camera *c, l2p_error *err)
 {
+    field_angles f;
+    if (field_angles_open(&f, c))
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     /* Paraxial scale k = r / tan(theta) near the axis: the image height that a distortion-free
        lens (image height proportional to tan(theta)) would give is k tan(theta). */
     const double r0 = 1e-3 * film_radius(c, 1);
     double theta0;
-    const double k = chief_angle(c, r0, &theta0) ? r0 / tan(theta0) : NAN;
+    const double k = imaged_angle(&f, r0, &theta0) ? r0 / tan(theta0) : NAN;
     fprintf(out, "# %s: distortion of the chief ray against k tan(theta), k = %.9g mm\n"
                  "# film_radius_mm field_angle_deg paraxial_height_mm distortion_percent\n",
             c->lens.name, k);
@@ -45,7 +44,7 @@ void plot_distortion_table(FILE *out, const camera *c)
             fprintf(out, "0 0 0 0\n");
             continue;
         }
-        if (!chief_angle(c, r, &theta))
+        if (!imaged_angle(&f, r, &theta))
             continue;   /* beyond a fisheye's image circle */
         /* At 90 degrees and beyond tan(theta) no longer grows: no paraxial height. */
         if (theta < 0.5 * M_PI)
@@ -54,6 +53,8 @@ void plot_distortion_table(FILE *out, const camera *c)
         else   /* gnuplot reads NaN as a missing value */
             fprintf(out, "%.9g %.9g NaN NaN\n", r, theta * 180.0 / M_PI);
     }
+    field_angles_close(&f);
+    return L2P_OK;
 }
 
 /* E at film radius r through camera c: the full lens's passing directions, or with --trace

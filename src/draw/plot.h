@@ -17,9 +17,9 @@ enum { PLOT_WIDTH_PX = 800, PLOT_HEIGHT_PX = 500 };
 /* Writes the distortion table: film radius (mm), the chief ray's field angle (deg), the
    paraxial image height k tan(theta) (mm) and the distortion 100 (r / (k tan theta) - 1) (%),
    with k the limit of r / tan(theta) at the axis (the focal length when focused at infinity).
-   The chief ray leaves film point (0, r) toward the middle of its pupil region; rows beyond a
-   fisheye's image circle are left out. */
-void plot_distortion_table(FILE *out, const camera *c);
+   The field angle is camera/fieldangle.h's (the chief ray through the stop's centre); rows
+   beyond a fisheye's image circle are left out. L2P_FAILED out of memory. */
+int plot_distortion_table(FILE *out, const camera *c, l2p_error *err);
 
 /* Writes E(r)/E(0) for each camera (the same lens at several f-numbers), one column each:
    irradiance_at (optics/irradiance.h) at film point (0, r), or with --trace thick

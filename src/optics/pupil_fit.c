@@ -8,6 +8,7 @@
    from the middle of that extent. All directions are bisected in lockstep, so that the lane
    tracer takes them side by side. */
 #include "optics/pupil.h"
+#include "optics/chief.h"
 #include "optics/trace_batch.h"
 
 enum {
@@ -118,9 +119,23 @@ static double search_half_side_mm(const pupil *pu, const lens *l, double r)
     return 1.5 * (r + (r + a) * fabs(pu->z_mm) / z_near);
 }
 
+/* Where the chief ray of film radius r crosses the pupil plane: inside the region unless a rim
+   cuts it, however small the stop (a region far smaller than the scan's step is found there). */
+static bool chief_point(const pupil *pu, const lens *l, double r, double *x)
+{
+    chief_lens c;
+    double slope;
+    if (chief_lens_open(&c, l))
+        return false;
+    const bool ok = chief_slope(&c, r, &slope);
+    chief_lens_close(&c);
+    *x = r + slope * pu->z_mm;
+    return ok && isfinite(*x);
+}
+
 /* A passing point of the x axis: the guess, then points a quarter of size apart either side
-   of it, then a scan of the whole useful segment (near the reach the region is a sliver that
-   the search near the guess can miss). */
+   of it, then the chief ray's, then a scan of the whole useful segment (near the reach the
+   region is a sliver that the search near the guess can miss). */
 static bool find_on_axis(const pupil *pu, const lens *l, double r, double guess, double size,
                          double *x)
 {
@@ -137,6 +152,8 @@ static bool find_on_axis(const pupil *pu, const lens *l, double r, double guess,
             *x = xs[k];
             return true;
         }
+    if (chief_point(pu, l, r, x) && passes(pu, l, r, *x, 0.0))
+        return true;
     const double half = search_half_side_mm(pu, l, r);
     for (int done = 0; done < SCAN; done += TRACE_BATCH_MAX) {
         double sx[TRACE_BATCH_MAX], sy[TRACE_BATCH_MAX] = {0};

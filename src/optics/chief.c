@@ -1,0 +1,133 @@
+/* The chief ray (chief.h): its slope at the film found by Newton's method on where it crosses
+   the stop's plane, from the paraxial aim or else from a bracket of a scan. */
+#include "optics/chief.h"
+
+#include <math.h>
+#include <string.h>
+#include "optics/pupil.h"
+
+/* Far beyond any lens, in mm: rims this wide never cut a ray. */
+#define OPEN_DIAMETER_MM 1e9
+/* Where the chief ray crosses the stop's plane, at most this far from its centre, mm. */
+#define AIM_MM 1e-11
+/* The scan for a bracket: slopes -SCAN_SLOPE .. SCAN_SLOPE (about 84 degrees) in SCAN_STEPS. */
+#define SCAN_SLOPE 10.0
+#define SCAN_STEPS 400
+
+int chief_lens_open(chief_lens *c, const lens *l)
+{
+    double z, radius;
+    c->aim_z_mm = pupil_stop_image(l, true, &z, &radius, NULL) == L2P_OK && fabs(z) > 1e-9 ? z : NAN;
+    if (lens_copy(&c->open, l))
+        return L2P_FAILED;
+    for (int i = 0; i < c->open.count; i++)
+        c->open.surface[i].aperture_diameter_mm = OPEN_DIAMETER_MM;
+    c->open.stop_diameter_mm = OPEN_DIAMETER_MM;
+    lens_set_blades(&c->open, 0, 0.0);
+    return L2P_OK;
+}
+
+void chief_lens_close(chief_lens *c)
+{
+    lens_free(&c->open);
+}
+
+/* The ray from film point (r, 0, 0) with slope dx/dz = t. */
+static ray from_film(double r, double t)
+{
+    ray y = {v3(r, 0, 0), v3_normalize(v3(t, 0, 1))};
+    return y;
+}
+
+/* Where the ray of slope t crosses the stop's plane, x in mm, having crossed the surfaces
+   between the film and the stop; false when it does not get there. */
+static bool stop_height(const lens *open, double r, double t, double *x_mm)
+{
+    ray y = from_film(r, t);
+    if (open->stop < open->count - 1 &&
+        trace_toward_scene(open, open->stop + 1, open->count - 1, &y, NULL) != TRACE_PASSED)
+        return false;
+    if (!(y.d.z > 0))
+        return false;
+    *x_mm = y.o.x + (open->surface[open->stop].vertex_z_mm - y.o.z) / y.d.z * y.d.x;
+    return isfinite(*x_mm);
+}
+
+/* Newton's method from slope *t, the derivative by a forward difference; a step that leaves
+   the lens is halved until it does not. */
+static bool newton(const lens *open, double r, double *t)
+{
+    double h;
+    if (!stop_height(open, r, *t, &h))
+        return false;
+    for (int k = 0; k < 60 && fabs(h) > AIM_MM; k++) {
+        const double dt = 1e-7 * (1.0 + fabs(*t));
+        double h2, next = NAN, step;
+        if (!stop_height(open, r, *t + dt, &h2) || !(h2 != h))
+            return false;
+        step = -h * dt / (h2 - h);
+        int halvings = 0;
+        while (!stop_height(open, r, *t + step, &next) && ++halvings < 40)
+            step *= 0.5;
+        if (halvings == 40)
+            return false;
+        *t += step;
+        h = next;
+    }
+    return fabs(h) <= AIM_MM;
+}
+
+/* A start for newton() when the paraxial aim fails: of the slopes between which the crossing
+   changes side, both passing, the pair nearest the paraxial aim t0. */
+static bool bracket(const lens *open, double r, double t0, double *t)
+{
+    double best = INFINITY, prev_t = NAN, prev_h = NAN;
+    for (int k = 0; k <= SCAN_STEPS; k++) {
+        const double s = -SCAN_SLOPE + 2.0 * SCAN_SLOPE * k / SCAN_STEPS;
+        double h;
+        if (!stop_height(open, r, s, &h)) {
+            prev_t = NAN;
+            continue;
+        }
+        if (!isnan(prev_t) && (h <= 0) != (prev_h <= 0)) {
+            const double mid = prev_t - prev_h * (s - prev_t) / (h - prev_h);
+            if (fabs(mid - t0) < fabs(best - t0))
+                best = mid;
+        }
+        prev_t = s, prev_h = h;
+    }
+    *t = best;
+    return isfinite(best);
+}
+
+bool chief_slope(const chief_lens *c, double film_radius_mm, double *slope)
+{
+    const double r = film_radius_mm;
+    /* toward the middle of the paraxial exit pupil (behind the film when it is virtual), or
+       parallel to the axis when the pupil is at infinity (telecentric) */
+    const double t0 = r > 0 && isfinite(c->aim_z_mm) ? -r / c->aim_z_mm : 0.0;
+    *slope = t0;
+    return newton(&c->open, r, slope) ||
+           (bracket(&c->open, r, t0, slope) && newton(&c->open, r, slope));
+}
+
+bool chief_ray(const chief_lens *c, double film_radius_mm, ray *out)
+{
+    double t;
+    if (!chief_slope(c, film_radius_mm, &t))
+        return false;
+    ray y = from_film(film_radius_mm, t);
+    if (trace_toward_scene(&c->open, 0, c->open.count - 1, &y, NULL) != TRACE_PASSED)
+        return false;
+    *out = y;
+    return true;
+}
+
+bool chief_angle(const chief_lens *c, double film_radius_mm, double *theta_rad)
+{
+    ray y;
+    if (!chief_ray(c, film_radius_mm, &y))
+        return false;
+    *theta_rad = atan2(hypot(y.d.x, y.d.y), y.d.z);
+    return true;
+}
