@@ -306,16 +306,17 @@ Test(animation, changing_focus_traces_again)
     cr_expect(file_exists(tmp_path(dir, "f1.png")) && file_exists(tmp_path(dir, "f2.png")));
 }
 
-/* An .ini (with the animation in it) and +L given relative to the current folder, while
-   POV-Ray runs in the scene's. */
-Test(animation, ini_and_library_path_relative_to_here)
+/* Renders a scene of dir from its folder sub, given "--" ini (an .ini of sub, whose text is
+   ini_text) and +L. : both relative to the current folder, while POV-Ray runs in the scene's.
+   Returns the folder. */
+static const char *render_from_sub(const char *ini_text, const char *ini)
 {
     const char *dir = test_tmpdir();
     char scene_buf[512], sub[512], cwd[512], exe[1024];
     const char *scene = hold(scene_buf, dir, "scene.pov");
     hold(sub, dir, "sub");
     cr_assert_eq(mkdir(sub, 0777), 0);
-    write_text(tmp_path(sub, "a.ini"), "Initial_Frame=1\nFinal_Frame=2\n");
+    write_text(tmp_path(sub, "a.ini"), ini_text);
     write_text(tmp_path(sub, "lib.inc"), "#declare Shade = 0.5;\n");
     write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n#include \"lib.inc\"\n"
                       "camera { location <clock, 1, -4> look_at <clock, 1, 0> }\n"
@@ -330,8 +331,24 @@ Test(animation, ini_and_library_path_relative_to_here)
     cr_assert_eq(chdir(sub), 0);
     char *errtext = NULL;
     const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--jobs", "1", "-q",
-                       "-o", tmp_path(dir, "r.png"), "--", "a.ini", "+L.");
+                       "-o", tmp_path(dir, "r.png"), "--", ini, "+L.");
     cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
     free(errtext);
+    return dir;
+}
+
+/* An .ini with the animation in it, and +L. */
+Test(animation, ini_and_library_path_relative_to_here)
+{
+    const char *dir = render_from_sub("Initial_Frame=1\nFinal_Frame=2\n", "a.ini");
     cr_expect(file_exists(tmp_path(dir, "r1.png")) && file_exists(tmp_path(dir, "r2.png")));
+}
+
+/* A section of an .ini (POV-Ray's FILE.ini[Section]): the section named, not the others. */
+Test(animation, an_ini_section_relative_to_here)
+{
+    const char *dir = render_from_sub("[Still]\nDeclare=Unused=1\n[Two]\nInitial_Frame=1\n"
+                                      "Final_Frame=2\n", "a.ini[Two]");
+    cr_expect(file_exists(tmp_path(dir, "r1.png")) && file_exists(tmp_path(dir, "r2.png")));
+    cr_expect(!file_exists(tmp_path(dir, "r.png")));
 }

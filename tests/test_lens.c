@@ -289,10 +289,13 @@ Test(lens, line_numbers_in_a_crlf_file)
 }
 
 /* Rows ended by CR alone (old Mac files) read as one line: said so, not "unexpected '-10'
-   after the 5 numbers". A CR in a comment, or before blanks and the LF, is no such thing. */
+   after the 5 numbers", nor "no surfaces" when that line is a comment. A CR in a comment, or
+   before blanks and the LF, is no such thing. */
 Test(lens, cr_only_line_endings_are_named)
 {
     REFUSED("10 2 1.5 8\r0 1 0 4\r-10 5 1 8\r", 1, "carriage return (CR) inside the line");
+    /* a library file's header comment first: the whole file is that comment */
+    REFUSED("# a lens\r10 2 1.5 8\r0 1 0 4\r-10 5 1 8\r", 1, "rows end with CR alone");
     lens l = parsed("# a comment\rwith a CR\n10 2 1.5 8 \r \n0 1 0 4\r\n-10 5 1 8\r\n");
     expect_minimal(&l);
     lens_free(&l);

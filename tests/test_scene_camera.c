@@ -99,21 +99,44 @@ Test(scene_camera, transforms_and_the_last_camera)
                              "  rotate <0, 5, 0> translate Target }\n");
 }
 
-Test(scene_camera, orthographic_is_refused)
+/* The scene, written into a fresh folder as name, is refused (exit 2) with a message that
+   names it and holds why, and no picture is written; its path into scene. Returns the message
+   (malloc'd). */
+static char *expect_refused(const char *name, const char *text, const char *why, char scene[512])
 {
     const char *dir = test_tmpdir();
-    char scene[512], out[512];
-    snprintf(scene, sizeof scene, "%s/ortho.pov", dir);
+    char out[512];
+    snprintf(scene, 512, "%s/%s", dir, name);
     snprintf(out, sizeof out, "%s/out.png", dir);
-    write_text(scene, MARKERS_HEAD "camera { orthographic location <0, 1, -4> look_at 0 }\n");
+    write_text(scene, text);
     char *errtext = NULL;
     const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
-    cr_expect_eq(st, 2);
-    cr_expect(errtext && strstr(errtext, scene) && strstr(errtext, "orthographic"), "%s",
-              errtext ? errtext : "");
-    struct stat sb;
-    cr_expect(stat(out, &sb) != 0, "an output was written");
-    free(errtext);
+    cr_expect_eq(st, 2, "%s", errtext ? errtext : "");
+    cr_expect(errtext && strstr(errtext, scene) && strstr(errtext, why), "expected '%s' in: %s",
+              why, errtext ? errtext : "");
+    cr_expect(!file_exists(out), "an output was written");
+    return errtext;
+}
+
+/* A rotation written to 4 decimals, as exporters write matrices, is a rotation: its vectors
+   are skewed by about 1e-4, a shear no picture shows. A shear of 1% is refused. */
+Test(scene_camera, a_matrix_rounded_to_four_decimals_is_a_rotation)
+{
+    expect_markers_as_povray(MARKERS_HEAD
+                             "camera { location Lift(Eye) - Target look_at 0 angle 40\n"
+                             "  matrix <0.9659, 0, 0.2588, 0, 1, 0, -0.2588, 0, 0.9659, 0, 0, 0>\n"
+                             "  translate Target }\n");
+    char scene[512];
+    free(expect_refused("sheared.pov", MARKERS_HEAD "camera { location <0, 1, -4> look_at 0\n"
+                        "  matrix <1, 0, 0, 0.01, 1, 0, 0, 0, 1, 0, 0, 0> }\n", "not perpendicular",
+                        scene));
+}
+
+Test(scene_camera, orthographic_is_refused)
+{
+    char scene[512];
+    free(expect_refused("ortho.pov", MARKERS_HEAD "camera { orthographic location <0, 1, -4> "
+                        "look_at 0 }\n", "orthographic", scene));
 }
 
 /* Conditionals, #debug and #warning inside the camera block are followed as POV-Ray follows
@@ -244,6 +267,24 @@ Test(scene_camera, a_camera_normal_is_left_out_with_a_warning)
                      errtext ? errtext : "");
         free(errtext);
     }
+}
+
+/* An item that a macro gives: POV-Ray reads the scene, but lens2pov cannot print the items of
+   its camera. Said so, with POV-Ray's complaint about the copy, and the camera given on the
+   command line renders it. */
+Test(scene_camera, an_item_from_a_macro_asks_for_the_camera_on_the_command_line)
+{
+    char scene[512], out[600];
+    char *errtext = expect_refused("macro.pov", MARKERS_HEAD "#macro Aim() look_at Target #end\n"
+                                   "camera { location <0, 1, -4> Aim() }\n",
+                                   "POV-Ray reads the scene", scene);
+    cr_expect(errtext && strstr(errtext, "look_at") && strstr(errtext, "--location"), "%s",
+              errtext ? errtext : "");
+    free(errtext);
+    snprintf(out, sizeof out, "%s.png", scene);
+    cr_expect_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out,
+                     "--location", "0,1,-4", "--look-at", "0.2,0.5,0"), 0);
+    cr_expect(file_exists(out));
 }
 
 /* Any other directive inside the block, a conditional that does not stand between items (in

@@ -32,6 +32,8 @@ static int setup_placement(camera *c, const camera_options *o, l2p_error *err)
     if (!(v3_length(ahead) > 0.0))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--look-at must differ from --location");
     c->forward = v3_normalize(ahead);
+    if (!(v3_length(o->sky) > 0.0) || !v3_isfinite(o->sky))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--sky must be a direction: not 0,0,0");
     const vec3 side = v3_cross(o->sky, c->forward);
     if (!(v3_length(side) > 1e-12 * v3_length(o->sky)))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,

@@ -10,6 +10,7 @@
 #include <fcntl.h>
 #include <locale.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -317,10 +318,25 @@ static int parse_rows(const char *text, size_t length, const char *path, lens *l
     return L2P_OK;
 }
 
-/* What the rows must make together: at least one surface, one stop, one refracting surface.
-   What is missing is found missing at the end of the file, so that is the line named. */
-static int check_lens(const lens *l, int last_line, l2p_error *err)
+/* Whether the text has a CR that no LF follows: rows ended by CR alone. */
+static bool has_bare_cr(const char *text, size_t length)
 {
+    for (size_t i = 0; i < length; i++)
+        if (text[i] == '\r' && (i + 1 == length || text[i + 1] != '\n'))
+            return true;
+    return false;
+}
+
+/* What the rows must make together: at least one surface, one stop, one refracting surface.
+   What is missing is found missing at the end of the file, so that is the line named. A file
+   of rows ended by CR alone whose first line is a comment reads as that one comment. */
+static int check_lens(const lens *l, int last_line, bool bare_cr, l2p_error *err)
+{
+    if (l->count == 0 && bare_cr)
+        return l2p_fail(err, L2P_BAD_INPUT, l->path, last_line,
+                        "no surfaces, and carriage returns (CR) with no line feed after them: "
+                        "rows end with CR alone, as in old Mac files; convert the line endings "
+                        "to LF");
     if (l->count == 0)
         return l2p_fail(err, L2P_BAD_INPUT, l->path, last_line,
                         "no surfaces by the end of the file (a row is 4 numbers)");
@@ -379,7 +395,7 @@ int lens_parse(const char *text, size_t length, const char *name, lens *out, l2p
     if (!st)
         st = parse_in_c_locale(text, length, &l, &last_line, err);
     if (!st)
-        st = check_lens(&l, last_line, err);
+        st = check_lens(&l, last_line, has_bare_cr(text, length), err);
     if (st) {
         lens_free(&l);
         return st;

@@ -92,10 +92,20 @@ bool povargs_end_with_pictures(char *const *args, int count)
     return true;
 }
 
+/* The length of a file name given alone without the section POV-Ray reads of it, as in
+   "FILE.ini[Section]". */
+static size_t without_section(const char *a)
+{
+    const size_t n = strlen(a);
+    const char *open = strrchr(a, '[');
+    return open && open > a && n > 0 && a[n - 1] == ']' ? (size_t)(open - a) : n;
+}
+
 static char *resolved(const char *head, size_t head_len, const char *path)
 {
-    char cwd[4096];
-    const bool relative = path[0] && path[0] != '/' && access(path, F_OK) == 0 &&
+    char cwd[4096], file[4096];
+    snprintf(file, sizeof file, "%.*s", (int)without_section(path), path);
+    const bool relative = path[0] && path[0] != '/' && access(file, F_OK) == 0 &&
                           getcwd(cwd, sizeof cwd);
     const size_t n = head_len + strlen(path) + (relative ? strlen(cwd) + 2 : 1);
     char *s = malloc(n);
@@ -230,9 +240,9 @@ static void take_ini(paths *p, const char *folder, const char *path)
 
 static bool is_ini(const char *a)
 {
-    const size_t n = strlen(a);
+    const size_t n = without_section(a);
     return a[0] != '+' && a[0] != '-' && !strchr(a, '=') && n > 4 &&
-           !strcasecmp(a + n - 4, ".ini");
+           !strncasecmp(a + n - 4, ".ini", 4);
 }
 
 void povargs_default_inis(const char *folder, char buf[POVARGS_INIS][POVARGS_INI_PATH],
@@ -263,8 +273,8 @@ char **povargs_library_paths(const char *folder, char *const *args, int count)
             continue;
         }
         char ini[POVARGS_INI_PATH];
-        snprintf(ini, sizeof ini, "%s%s%s", args[i][0] == '/' ? "" : folder,
-                 args[i][0] == '/' ? "" : "/", args[i]);
+        snprintf(ini, sizeof ini, "%s%s%.*s", args[i][0] == '/' ? "" : folder,
+                 args[i][0] == '/' ? "" : "/", (int)without_section(args[i]), args[i]);
         take_ini(&p, folder, ini);
     }
     if (!p.failed && !p.dir)

@@ -10,8 +10,11 @@
 
 /* POV-Ray's EPSILON in the camera code. */
 #define POV_EPSILON 1e-10
-/* Cosine between two camera vectors above which lens2pov calls them skewed. */
-#define SKEW_COS 1e-6
+/* Cosine between two camera vectors above which lens2pov calls them skewed. A skew of c shears
+   POV-Ray's picture by about c of its size, which lens2pov, making the vectors perpendicular,
+   leaves out: half a pixel at 1000 pixels. A rotation matrix written to 4 decimals, as
+   exporters write them, is skewed by up to about 1e-4. */
+#define SKEW_COS 5e-4
 
 /* ---------------------------------------------------------------- the items, as POV-Ray's rules */
 

@@ -304,6 +304,40 @@ static void probe_error(const char *scene, const char *dir, const char *top, con
     free(links);
 }
 
+/* After the copy failed: POV-Ray on the scene as it is. When that fails too, its error is the
+   scene's, named in the user's own files; when it does not, the copy's camera statement, which
+   prints each item, is what POV-Ray could not read (an item that a macro gives, say), and the
+   camera is to be given on the command line. */
+static void copy_or_scene_error(const char *scene, const char *dir, const char *work, int w,
+                                int h, const probe_args *pa, l2p_error *err)
+{
+    char log[4200], abs[4200], cwd[4096];
+    snprintf(log, sizeof log, "%s/scene-alone.log", work);
+    if (scene[0] == '/' || !getcwd(cwd, sizeof cwd))
+        snprintf(abs, sizeof abs, "%s", scene);
+    else
+        snprintf(abs, sizeof abs, "%s/%s", cwd, scene);
+    l2p_error alone;
+    int st;
+    for (int retries = 0;; retries++) {
+        st = run_probe(dir, abs, log, w, h, pa, &alone);
+        if (st >= 0 || !povray_retry_transient(log, retries))
+            break;
+    }
+    const povray_log_names names = {scene, dir, {NULL, NULL}, NULL, 0};
+    if (st < 0 && povray_log_error(log, &names, &alone))
+        *err = alone;
+    else if (st == L2P_OK) {
+        char copy_error[sizeof err->text];
+        snprintf(copy_error, sizeof copy_error, "%s", err->text);
+        l2p_fail(err, L2P_BAD_INPUT, scene, 0, "lens2pov cannot read the scene's camera: POV-Ray "
+                 "reads the scene, but not the copy that prints each item of its camera "
+                 "(POV-Ray on the copy: %s); give the camera with --location, --look-at and "
+                 "--angle instead (an item given by a macro can do this)", copy_error);
+    }
+    unlink(log);
+}
+
 static int run_copy(const char *scene, const char *dir, const char *work, int w, int h,
                     const probe_args *pa, const scene_copy *sc, scene_frames *out,
                     l2p_error *err)
@@ -321,6 +355,8 @@ static int run_copy(const char *scene, const char *dir, const char *work, int w,
             st = L2P_BAD_INPUT;
         if (st < 0) {
             probe_error(scene, dir, top, copy, log, sc, err);
+            if (err->status == L2P_BAD_INPUT)
+                copy_or_scene_error(scene, dir, work, w, h, pa, err);
             st = err->status;
         }
     }
