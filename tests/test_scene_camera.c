@@ -14,69 +14,8 @@
 #include <unistd.h>
 #include "image/image_io.h"
 #include "povray/scenecam.h"
+#include "scene_markers.h"
 #include "support.h"
-
-#define DGAUSS LENS_DIR "dgauss.50mm.dat"
-#define L2P(out, errtext, ...) run_lens2pov(out, errtext, __VA_ARGS__, (char *)NULL)
-#define SIZE "--width", "64", "--height", "48"
-
-/* The camera uses #declared vectors, an expression, a macro, angle and image_width. */
-#define MARKERS_HEAD                                                                            \
-    "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"                                    \
-    "#declare Eye = <1, 1.5, -4>;\n#declare Target = <0.2, 0.5, 0>;\n"                         \
-    "#macro Lift(V) (V + <0, 0.5, 0> * 2) #end\n"                                               \
-    "#macro Marker(P, C) sphere { P, 0.06 pigment { rgb C }\n"                                  \
-    "    finish { ambient 0 emission 1 diffuse 0 } } #end\n"                                   \
-    "Marker(Target, <1, 0, 0>)\nMarker(Target + <0.8, 0, 0>, <0, 1, 0>)\n"                      \
-    "Marker(Target + <0, 0.6, 0.3>, <0, 0, 1>)\n"
-
-#define CAMERA(right)                                                                           \
-    "camera {\n  location Lift(Eye) // where it stands\n  look_at Target\n  angle 40\n"        \
-    "  right " right " * image_width / image_height\n}\n"
-
-/* POV-Ray's own picture of the scene, with the option opt ("" for none). */
-static void povray_render(const char *dir, const char *scene, const char *out, const char *opt)
-{
-    char cmd[1600];
-    snprintf(cmd, sizeof cmd,
-             "cd '%s' && povray +I%s +O%s +W64 +H48 +FN -A -D -V -GA %s >povray.log 2>&1", dir,
-             scene, out, opt);
-    cr_assert_eq(system_povray(cmd), 0, "%s", cmd);
-}
-
-/* The scene, in dir, through the lens, with no placement and --angle scene, against POV-Ray's
-   camera; library, when not NULL, a folder given to both as +L. */
-static void expect_markers_in(const char *dir, const char *scene_text, const char *library)
-{
-    char scene[512], own[512], lens[512], opt[600] = "";
-    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
-    snprintf(own, sizeof own, "%s/own.png", dir);
-    snprintf(lens, sizeof lens, "%s/lens.png", dir);
-    if (library)
-        snprintf(opt, sizeof opt, "+L%s", library);
-    write_text(scene, scene_text);
-    povray_render(dir, "scene.pov", "own.png", opt);
-    char *errtext = NULL;
-    const int st = library ? L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "4",
-                                 "--angle", "scene", "--jobs", "1", "-q", "-o", lens, "--", opt)
-                           : L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "4",
-                                 "--angle", "scene", "--jobs", "1", "-q", "-o", lens);
-    cr_assert_eq(st, 0, "render failed: %s", errtext ? errtext : "");
-    free(errtext);
-    for (int c = 0; c < 3; c++) {
-        const marker_centroid a = image_marker(own, c), b = image_marker(lens, c);
-        cr_assert(a.found && b.found, "marker %d missing (POV-Ray %d, lens %d)", c, a.found, b.found);
-        cr_log_info("marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", c, a.x, a.y, b.x, b.y);
-        /* The lens has a little distortion and depth of field; a pixel is the tolerance. */
-        cr_expect(fabs(a.x - b.x) < 1.0 && fabs(a.y - b.y) < 1.0,
-                  "marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", c, a.x, a.y, b.x, b.y);
-    }
-}
-
-static void expect_markers_as_povray(const char *scene_text)
-{
-    expect_markers_in(test_tmpdir(), scene_text, NULL);
-}
 
 Test(scene_camera, declared_vectors_expression_and_angle)
 {
@@ -99,45 +38,8 @@ Test(scene_camera, transforms_and_the_last_camera)
                              "  rotate <0, 5, 0> translate Target }\n");
 }
 
-/* The scene, written into a fresh folder as name, is refused (exit 2) with a message that
-   names it and holds why, and no picture is written; its path into scene. Returns the message
-   (malloc'd). */
-static char *expect_refused(const char *name, const char *text, const char *why, char scene[512])
-{
-    const char *dir = test_tmpdir();
-    char out[512];
-    snprintf(scene, 512, "%s/%s", dir, name);
-    snprintf(out, sizeof out, "%s/out.png", dir);
-    write_text(scene, text);
-    char *errtext = NULL;
-    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
-    cr_expect_eq(st, 2, "%s", errtext ? errtext : "");
-    cr_expect(errtext && strstr(errtext, scene) && strstr(errtext, why), "expected '%s' in: %s",
-              why, errtext ? errtext : "");
-    cr_expect(!file_exists(out), "an output was written");
-    return errtext;
-}
 
-/* A rotation written to 4 decimals, as exporters write matrices, is a rotation: its vectors
-   are skewed by about 1e-4, a shear no picture shows. A shear of 1% is refused. */
-Test(scene_camera, a_matrix_rounded_to_four_decimals_is_a_rotation)
-{
-    expect_markers_as_povray(MARKERS_HEAD
-                             "camera { location Lift(Eye) - Target look_at 0 angle 40\n"
-                             "  matrix <0.9659, 0, 0.2588, 0, 1, 0, -0.2588, 0, 0.9659, 0, 0, 0>\n"
-                             "  translate Target }\n");
-    char scene[512];
-    free(expect_refused("sheared.pov", MARKERS_HEAD "camera { location <0, 1, -4> look_at 0\n"
-                        "  matrix <1, 0, 0, 0.01, 1, 0, 0, 0, 1, 0, 0, 0> }\n", "not perpendicular",
-                        scene));
-}
 
-Test(scene_camera, orthographic_is_refused)
-{
-    char scene[512];
-    free(expect_refused("ortho.pov", MARKERS_HEAD "camera { orthographic location <0, 1, -4> "
-                        "look_at 0 }\n", "orthographic", scene));
-}
 
 /* Conditionals, #debug and #warning inside the camera block are followed as POV-Ray follows
    them (focal blur switched by a quality setting is a common use). */
@@ -164,27 +66,6 @@ Test(scene_camera, a_lone_hash_before_the_blocks_end_is_passed_over)
                              "  right x * image_width / image_height #\n}\n");
 }
 
-/* A camera item POV-Ray evaluates to nan (its clock in an animation of one frame) is the
-   scene's fault: exit 2, naming the item, the statement's line and the clock. */
-Test(scene_camera, a_camera_that_evaluates_to_nan_is_refused)
-{
-    const char *dir = test_tmpdir();
-    char scene[512], out[512];
-    snprintf(scene, sizeof scene, "%s/anim.pov", dir);
-    snprintf(out, sizeof out, "%s/a.png", dir);
-    write_text(scene, "#version 3.7;\nsphere { 0, 1 pigment { rgb 1 } }\n"
-                      "camera { location <clock, 0, -5>\n look_at 0 }\n");
-    char *errtext = NULL;
-    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o",
-                       out, "--", "+KFI3", "+KFF3");
-    cr_expect_eq(st, 2, "exit %d: %s", st, errtext);
-    char where[600];
-    snprintf(where, sizeof where, "lens2pov: %s:3: the camera's location is not a finite number",
-             scene);
-    cr_expect(errtext && strncmp(errtext, where, strlen(where)) == 0, "%s", errtext);
-    cr_expect(errtext && strstr(errtext, "clock"), "%s", errtext);
-    free(errtext);
-}
 
 /* The probe's POV-Ray run, failing with "Timed out waiting for worker thread startup" (a
    loaded machine), is started again as a render's runs are: a stand-in that fails so on its
@@ -217,26 +98,6 @@ Test(scene_camera, a_probe_that_times_out_starting_is_run_again)
     free(errtext);
 }
 
-/* An #include of a file that cannot be found may hold a camera: POV-Ray is asked, and its
-   error is the answer (exit 2, the scene's line), not the default camera, whose 67 degrees
-   the double-Gauss cannot reach. */
-Test(scene_camera, a_missing_include_is_reported_not_taken_for_no_camera)
-{
-    const char *dir = test_tmpdir();
-    char scene[512], out[512];
-    snprintf(scene, sizeof scene, "%s/scene.pov", dir);
-    snprintf(out, sizeof out, "%s/a.png", dir);
-    write_text(scene, "#version 3.7;\n#include \"mycam.inc\"\nPlaceCam(<0, 1, -5>)\n");
-    char *errtext = NULL;
-    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "--angle",
-                       "scene", "-q", "-o", out);
-    cr_expect_eq(st, 2, "exit %d: %s", st, errtext);
-    char where[600];
-    snprintf(where, sizeof where, "lens2pov: %s:2: ", scene);
-    cr_expect(errtext && strncmp(errtext, where, strlen(where)) == 0, "%s", errtext);
-    cr_expect(errtext && strstr(errtext, "mycam.inc"), "%s", errtext);
-    free(errtext);
-}
 
 /* A camera normal { } perturbs POV-Ray's rays, which no lens does: it is left out with a
    warning naming the scene, whether the camera is read by POV-Ray (an expression) or as plain
@@ -269,64 +130,7 @@ Test(scene_camera, a_camera_normal_is_left_out_with_a_warning)
     }
 }
 
-/* An item that a macro gives: POV-Ray reads the scene, but lens2pov cannot print the items of
-   its camera. Said so, with POV-Ray's complaint about the copy, and the camera given on the
-   command line renders it. */
-Test(scene_camera, an_item_from_a_macro_asks_for_the_camera_on_the_command_line)
-{
-    char scene[512], out[600];
-    char *errtext = expect_refused("macro.pov", MARKERS_HEAD "#macro Aim() look_at Target #end\n"
-                                   "camera { location <0, 1, -4> Aim() }\n",
-                                   "POV-Ray reads the scene", scene);
-    cr_expect(errtext && strstr(errtext, "look_at") && strstr(errtext, "--location"), "%s",
-              errtext ? errtext : "");
-    free(errtext);
-    snprintf(out, sizeof out, "%s.png", scene);
-    cr_expect_eq(L2P(NULL, NULL, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out,
-                     "--location", "0,1,-4", "--look-at", "0.2,0.5,0"), 0);
-    cr_expect(file_exists(out));
-}
 
-/* Any other directive inside the block, a conditional that does not stand between items (in
-   an expression, or before a word that is no item), a type chosen by a conditional that runs,
-   or a word that is no camera item is refused naming the statement's line (exit 2); a type in
-   a branch that does not run is not read. POV-Ray's error in a block written over several
-   lines names the line it is on. */
-Test(scene_camera, other_directives_and_unknown_words_are_refused)
-{
-    const char *dir = test_tmpdir();
-    static const struct {
-        const char *camera, *why;
-        int status, line;
-    } cases[] = {
-        {"camera { location <0, 1, -4>\n  #declare A = 1; look_at 0 }\n", "#warning", 2, 1},
-        {"camera { 3 location <0, 1, -4>\n  look_at 0 }\n", "not a camera", 2, 1},
-        {"camera { location <0, 1, -4>\n  #if (0) bogus 3 #end look_at 0 }\n", "between", 2, 1},
-        {"camera { location <0, 1, -4> angle #if (1) 40 #else 50 #end }\n", "between", 2, 1},
-        {"camera { location <0, #if (1) 1 #else 2 #end, -4> }\n", "between", 2, 1},
-        {"camera { location <0, 1, -4> #if (1) orthographic #end }\n", "conditional", 2, 1},
-        {"camera { location <0, 1, -4> #if (0) orthographic #end look_at 0 }\n", NULL, 0, 0},
-        {"\ncamera\n{\n  #if (1)\n    angle 40\n  #else\n    angle 50\n  #end\n"
-         "  look_at Undeclared\n}\n", "Undeclared", 2, 9},
-    };
-    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
-        char scene[512], out[512], where[600];
-        snprintf(scene, sizeof scene, "%s/d%zu.pov", dir, k);
-        snprintf(out, sizeof out, "%s/d%zu.png", dir, k);
-        write_text(scene, cases[k].camera);
-        char *errtext = NULL;
-        const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q",
-                           "-o", out);
-        snprintf(where, sizeof where, "lens2pov: %s:%d: ", scene, cases[k].line);
-        cr_expect_eq(st, cases[k].status, "case %zu: %s", k, errtext ? errtext : "");
-        if (cases[k].why)
-            cr_expect(errtext && !strncmp(errtext, where, strlen(where)) &&
-                          strstr(errtext, cases[k].why),
-                      "case %zu: expected '%s' and '%s' in: %s", k, where, cases[k].why,
-                      errtext ? errtext : "");
-        free(errtext);
-    }
-}
 
 /* A camera in a file the scene includes from its folder, nested two deep (the inner one
    named without its ".inc", which POV-Ray appends), after a camera of the scene's own: it is
@@ -362,42 +166,6 @@ Test(scene_camera, cameras_on_the_library_path)
                              "Set_Camera(Lift(Eye), Target, 40)\n");
 }
 
-/* What is wrong with a camera in an included file is reported in that file's name and line:
-   a camera lens2pov cannot stand in for (exit 2), and POV-Ray's own error. Nothing is
-   written; with explicit placement the first scene renders. */
-Test(scene_camera, an_included_cameras_faults_name_its_file)
-{
-    const char *dir = test_tmpdir();
-    char scene[512], broken[512], inc[512], bad[512], out[512];
-    snprintf(scene, sizeof scene, "%s/inc.pov", dir);
-    snprintf(broken, sizeof broken, "%s/broken.pov", dir);
-    snprintf(inc, sizeof inc, "%s/ortho.inc", dir);
-    snprintf(bad, sizeof bad, "%s/bad.inc", dir);
-    snprintf(out, sizeof out, "%s/out.png", dir);
-    write_text(inc, "\n\ncamera { orthographic location <0, 1, -4> look_at 0 }\n");
-    write_text(bad, "\ncamera { location <0, 1, -4> look_at Undeclared }\n");
-    write_text(scene, MARKERS_HEAD "#include \"ortho.inc\"\n");
-    write_text(broken, MARKERS_HEAD "#include \"bad.inc\"\n");
-    char *errtext = NULL, where[600];
-    int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
-    snprintf(where, sizeof where, "lens2pov: %s:3: ", inc);
-    cr_expect_eq(st, 2, "%s", errtext ? errtext : "");
-    cr_expect(errtext && !strncmp(errtext, where, strlen(where)) && strstr(errtext, "orthographic"),
-              "expected '%s' in: %s", where, errtext ? errtext : "");
-    free(errtext);
-    st = L2P(NULL, &errtext, "render", broken, DGAUSS, SIZE, "--spp", "1", "-q", "-o", out);
-    snprintf(where, sizeof where, "lens2pov: %s:2: ", bad);
-    cr_expect_neq(st, 0);
-    cr_expect(errtext && !strncmp(errtext, where, strlen(where)) && strstr(errtext, "Undeclared"),
-              "expected '%s' in: %s", where, errtext ? errtext : "");
-    free(errtext);
-    struct stat sb;
-    cr_expect(stat(out, &sb) != 0, "an output was written");
-    st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--spp", "1", "--location", "0,1,-4",
-             "--look-at", "0,0,0", "-q", "-o", out);
-    cr_expect_eq(st, 0, "%s", errtext ? errtext : "");
-    free(errtext);
-}
 
 /* Explicit placement wins: trace --scene with --location and --look-at writes what trace
    without the scene writes. */

@@ -65,7 +65,7 @@ typedef struct field_files_request {
 } field_files_request;
 
 /* That cost as POV-Ray is, and as lens2pov runs it, its polls shortened (povray_env.h): the
-   value that rendered fastest (docs/benchmarks.md, "session 11"). */
+   value that rendered fastest (docs/benchmarks-fields-2.md, "session 11"). */
 #define FIELD_FRAME_S 0.25
 #define FIELD_FRAME_POLLS_S 0.04
 
