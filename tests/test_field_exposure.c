@@ -422,3 +422,76 @@ Test(field_exposure, the_fit_margin_passes_little_light)
         camera_free(&c);
     }
 }
+
+/* The film centre's irradiance from a background of radiance 1 through lens l, whatever shape
+   passes (blades): E = integral of cos(theta) d(omega) = the area of the passing directions in
+   the plane of direction cosines (a, b), counted on an n x n grid over the square of half-side
+   sin(alpha) about the axis, alpha the widest passing angle. */
+static double centre_irradiance_grid(const lens *l, int n)
+{
+    double reach = 0.0;   /* the widest passing direction cosine, stepped out in 360 azimuths */
+    for (int k = 0; k < 360; k++) {
+        const double phi = 2.0 * M_PI * k / 360.0;
+        for (double a = 1e-3; a < 1.0; a += 1e-3) {
+            trace_batch s;
+            s.ox[0] = s.oy[0] = s.oz[0] = 0.0;
+            s.dx[0] = a * cos(phi), s.dy[0] = a * sin(phi), s.dz[0] = sqrt(1.0 - a * a);
+            s.status[0] = TRACE_PASSED;
+            trace_batch_toward_scene(l, &s, 1);
+            if (s.status[0] != TRACE_PASSED)
+                break;
+            reach = fmax(reach, a);
+        }
+    }
+    const double half = 1.02 * (reach + 1e-3), h = 2.0 * half / n;
+    long count = 0;
+    for (long start = 0; start < (long)n * n; start += TRACE_BATCH_MAX) {
+        const int m = (long)n * n - start < TRACE_BATCH_MAX ? (int)((long)n * n - start) : TRACE_BATCH_MAX;
+        trace_batch s;
+        for (int k = 0; k < m; k++) {
+            const double a = -half + ((start + k) % n + 0.5) * h, b = -half + ((start + k) / n + 0.5) * h;
+            s.ox[k] = s.oy[k] = s.oz[k] = 0.0;
+            s.dx[k] = a, s.dy[k] = b, s.dz[k] = sqrt(fmax(0.0, 1.0 - a * a - b * b));
+            s.status[k] = TRACE_PASSED;
+        }
+        trace_batch_toward_scene(l, &s, m);
+        for (int k = 0; k < m; k++)
+            count += s.status[k] == TRACE_PASSED;
+    }
+    return count * h * h;
+}
+
+/* With blades the region that passes on the axis is their polygon, not a disk: the shared
+   samples are weighted by whether they pass there (post-stratified, src/field/strata.c), and
+   the film centre is exposed right for every seed. Eight seeds at 64 spp, f/8, five blades on
+   the double-Gauss and three turned 45 degrees on the telephoto, against the irradiance the
+   lens alone passes (a grid of direction cosines: its cells along the polygon's edges make an
+   error of about 1e-3). Before, the centre moved by 5-15% with the seed, as the shared points
+   fell inside the polygon or between it and its circle. */
+Test(field_exposure, with_blades_the_film_centre_is_exposed_right_for_every_seed)
+{
+    static const struct { const char *lens; int blades; double rotation; } BLADES[] = {
+        {"dgauss.50mm", 5, 0.0}, {"telephoto.250mm", 3, 45.0}};
+    const int n = FULL_OR_ASAN(1024, 512);
+    for (int i = 0; i < 2; i++) {
+        double expected = 0.0;
+        for (uint64_t seed = 1; seed <= 8; seed++) {
+            camera_options o;
+            camera_options_default(&o);
+            o.width = 64, o.height = 48, o.spp = 64, o.seed = seed, o.f_number = 8.0;
+            o.focus_distance_units = 3.0;
+            o.weighting = WEIGHTING_PHYSICAL;
+            o.aperture_blades = BLADES[i].blades, o.blade_rotation_deg = BLADES[i].rotation;
+            camera c;
+            test_camera(&c, BLADES[i].lens, &o);
+            if (seed == 1)
+                expected = centre_irradiance_grid(&c.lens, n);
+            int core;
+            const double got = field_centre(&c, &core);
+            cr_expect(fabs(got / expected - 1.0) <= 3e-3, "%s, %d blades, seed %d: %.6g against "
+                      "%.6g (%.2e)", BLADES[i].lens, BLADES[i].blades, (int)seed, got, expected,
+                      got / expected - 1.0);
+            camera_free(&c);
+        }
+    }
+}

@@ -18,7 +18,16 @@
    N c^2 / K and a ring sample's by N (1 - c^2) / (N - K): each stratum's mean times its share
    of the disk. The axis is then exposed right for every seed, and off it the estimate is
    unbiased, but for the fit margin's sliver of light when the ring gets no sample
-   (ring_samples). */
+   (ring_samples).
+
+   With blades the region that passes on the axis is the blades' polygon (its image), no disk
+   about the axis. The samples are then post-stratified (Owen, section 8.9): left where they
+   are, split by whether they pass on the axis (K of N), and weighted N a / K and
+   N (1 - a) / (N - K), a the passing share of the unit disk, (1 / 2 pi) times the integral of
+   R(phi)^2 over the directions, R the passing radius bisected in each. Given K each stratum's
+   samples are uniform in it, so the estimate stays unbiased, and the axis is exposed right
+   for every seed. Only for a whole render's samples: adaptive sampling's later blocks would
+   need their own K. */
 #include "field/fieldpixels.h"
 #include "field/strata.h"
 
@@ -30,6 +39,21 @@ static double strata_nm(int i)
 {
     return SPECTRUM_MIN_NM + i * (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) / (FIELD_STRATA_WAVELENGTHS - 1);
 }
+
+/* A value measured at the strata's wavelengths, interpolated linearly at nm. */
+static double interpolate(const double at[FIELD_STRATA_WAVELENGTHS], double nm)
+{
+    const double x = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * (FIELD_STRATA_WAVELENGTHS - 1);
+    if (!(x > 0.0))
+        return at[0];
+    if (!(x < FIELD_STRATA_WAVELENGTHS - 1))
+        return at[FIELD_STRATA_WAVELENGTHS - 1];
+    const int i = (int)x;
+    return at[i] + (x - i) * (at[i + 1] - at[i]);
+}
+
+/* Directions over which the passing share of the disk on the axis is integrated. */
+enum { AXIS_DIRECTIONS = 512 };
 
 /* Whether the film's centre passes the pupil sample at radius r on the unit disk's x axis. */
 static bool axis_passes(const camera *c, double r, double nm, sample_batch *b)
@@ -56,6 +80,79 @@ static double core_radius_at(const camera *c, double nm, sample_batch *b)
         *(axis_passes(c, mid, nm, b) ? &in : &out) = mid;
     }
     return in;
+}
+
+/* The share of the unit disk that passes on the axis at nm: (1 / 2 pi) times the integral of
+   R(phi)^2 by the midpoint rule, R bisected to 2^-30 in each direction, the directions side by
+   side in the batch; 0 when the axis's own ray is blocked. */
+static double axis_share_at(const camera *c, double nm, sample_batch *b)
+{
+    if (!axis_passes(c, 0.0, nm, b))
+        return 0.0;
+    double sum = 0.0;
+    for (int first = 0; first < AXIS_DIRECTIONS; first += CAMERA_BATCH) {
+        const int n = AXIS_DIRECTIONS - first < CAMERA_BATCH ? AXIS_DIRECTIONS - first : CAMERA_BATCH;
+        double in[CAMERA_BATCH], out[CAMERA_BATCH];
+        for (int k = 0; k < n; k++)
+            in[k] = 0.0, out[k] = 1.0 + 1e-9;   /* the rim itself may pass */
+        for (int step = 0; step < 30; step++) {
+            b->n = n;
+            for (int k = 0; k < n; k++) {
+                const double phi = 2.0 * M_PI * (first + k + 0.5) / AXIS_DIRECTIONS;
+                const double r = fmin(1.0, 0.5 * (in[k] + out[k]));
+                b->film_point[k] = v3(0.0, 0.0, 0.0);
+                pupil_square_of_disk(r * cos(phi), r * sin(phi), &b->u[k], &b->v[k]);
+                b->wavelength_nm[k] = nm;
+            }
+            camera_trace_batch(c, b);
+            for (int k = 0; k < n; k++)
+                *(b->passed[k] ? &in[k] : &out[k]) = 0.5 * (in[k] + out[k]);
+        }
+        for (int k = 0; k < n; k++)
+            sum += fmin(1.0, in[k]) * fmin(1.0, in[k]);
+    }
+    return sum / AXIS_DIRECTIONS;
+}
+
+/* Whether shared sample s passes on the axis. */
+static bool passes_on_axis(const camera *c, film_sample s, sample_batch *b)
+{
+    b->n = 1;
+    b->film_point[0] = v3(0.0, 0.0, 0.0);
+    b->u[0] = s.pupil_u, b->v[0] = s.pupil_v;
+    b->wavelength_nm[0] = s.wavelength_nm;
+    camera_trace_batch(c, b);
+    return b->passed[0];
+}
+
+/* The share of a stratum averaged over the wavelengths' sampling density, lambda = P^-1(u) for
+   u uniform (spectrum.h), by the midpoint rule; the d line's without dispersion. */
+static double mean_over_spectrum(const double *at, const camera *c)
+{
+    if (!c->dispersion)
+        return at[0];
+    enum { STEPS = 4096 };
+    double sum = 0.0;
+    for (int i = 0; i < STEPS; i++)
+        sum += interpolate(at, spectrum_wavelength_nm((i + 0.5) / STEPS));
+    return sum / STEPS;
+}
+
+/* Post-stratification with blades (above): the passing share on the axis and the samples'
+   count there; off when either stratum would be empty. */
+static void post_count(const camera *c, int n, sample_batch *b, field_strata *out)
+{
+    double share[FIELD_STRATA_WAVELENGTHS];
+    const double d_line = c->dispersion ? 0.0 : axis_share_at(c, 0.0, b);
+    for (int i = 0; i < FIELD_STRATA_WAVELENGTHS; i++)
+        share[i] = c->dispersion ? axis_share_at(c, strata_nm(i), b) : d_line;
+    int passing = 0;
+    for (int k = 0; k < n; k++)
+        passing += passes_on_axis(c, field_shared_sample(c, k, NULL), b);
+    out->axis_share = mean_over_spectrum(share, c);
+    out->axis_count = passing;
+    out->camera = c;
+    out->post = passing > 0 && passing < n && out->axis_share > 0.0 && out->axis_share < 1.0;
 }
 
 /* The core's share: c^2 averaged over the wavelengths' sampling density, lambda = P^-1(u) for
@@ -99,6 +196,11 @@ void field_strata_count(const camera *c, int samples, field_strata *out)
         free(b);
         return;
     }
+    if (c->lens.blades.count > 0 && n == c->samples.spp) {
+        post_count(c, n, b, out);
+        free(b);
+        return;
+    }
     /* without dispersion every sample is traced at the d line: one radius serves */
     const double d_line = c->dispersion ? 0.0 : core_radius_at(c, 0.0, b);
     bool usable = true;
@@ -124,13 +226,7 @@ void field_strata_count(const camera *c, int samples, field_strata *out)
 
 double field_strata_core_radius(const field_strata *t, double nm)
 {
-    const double x = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * (FIELD_STRATA_WAVELENGTHS - 1);
-    if (!(x > 0.0))
-        return t->core_radius[0];
-    if (!(x < FIELD_STRATA_WAVELENGTHS - 1))
-        return t->core_radius[FIELD_STRATA_WAVELENGTHS - 1];
-    const int i = (int)x;
-    return t->core_radius[i] + (x - i) * (t->core_radius[i + 1] - t->core_radius[i]);
+    return interpolate(t->core_radius, nm);
 }
 
 bool field_strata_in_ring(const field_strata *t, film_sample s)
@@ -140,6 +236,12 @@ bool field_strata_in_ring(const field_strata *t, film_sample s)
 
 double field_strata_place(const field_strata *t, film_sample *s)
 {
+    if (t->post) {
+        sample_batch b;   /* one sample: on the stack, no failure to handle */
+        const int n = t->camera->samples.spp, k = t->axis_count;
+        return passes_on_axis(t->camera, *s, &b) ? n * t->axis_share / k
+                                                 : n * (1.0 - t->axis_share) / (n - k);
+    }
     if (!t->on)
         return 1.0;
     const double c = field_strata_core_radius(t, s->wavelength_nm), core = c * c;

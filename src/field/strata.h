@@ -11,7 +11,13 @@
 enum { FIELD_STRATA_WAVELENGTHS = 33 };
 
 typedef struct field_strata {
-    bool on;                   /* false: the shared samples as they are, every scale 1 */
+    bool on;                   /* false: the shared samples not moved, every scale 1 (but post) */
+    /* With blades the region that passes on the axis is the blades' polygon, not a disk: the
+       samples are left where they are and weighted by whether they pass there (post). */
+    bool post;
+    const camera *camera;      /* with post: the camera whose axis decides */
+    double axis_share;         /* with post: the share of the unit disk that passes there */
+    int axis_count;            /* with post: how many of the samples pass there */
     double core_radius[FIELD_STRATA_WAVELENGTHS];   /* on the unit disk; one value without dispersion */
     double ring_from;          /* a shared sample whose pupil_u is at least this goes to the ring */
     int core_count, ring_count;   /* how many of the shared samples go to each stratum */
@@ -30,7 +36,9 @@ bool field_strata_in_ring(const field_strata *t, film_sample s);
 
 /* Moves shared sample *s's pupil point into its stratum, uniformly over the stratum's part of
    the unit disk, and returns the factor for its sub-image's weights: the stratum's share of
-   the disk over its share of the samples. Leaves *s alone and returns 1 when t is off. */
+   the disk over its share of the samples. With post, leaves *s where it is and returns the
+   factor of its stratum: the samples that pass on the axis, or the others. Leaves *s alone
+   and returns 1 when t is neither. */
 double field_strata_place(const field_strata *t, film_sample *s);
 
 #endif
