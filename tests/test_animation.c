@@ -60,6 +60,13 @@ static void frames_match_povray(const char *sampling, const char *map)
     cr_expect_eq(count_entries(keep, map, NULL, 0), 1, "the lens was traced per frame");
     cr_expect_eq(count_entries(keep, "rays.t", NULL, 0) + count_entries(keep, "field.t", NULL, 0),
                  0, "a second table was traced");
+    /* The one table's renders are every frame's: develop asks which, naming them. */
+    char prefix[600];
+    snprintf(prefix, sizeof prefix, "%s/%.*s", keep, (int)strlen(map) - 4, map);
+    cr_expect_eq(L2P(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "again.png")), 2);
+    cr_expect(errtext && strstr(errtext, "frames 1, 2, 3") && strstr(errtext, "lens2pov develop"),
+              "%s", errtext ? errtext : "");
+    free(errtext);
     for (int f = 1; f <= 3; f++) {
         char own[32], lens[32];
         snprintf(own, sizeof own, "own%d.png", f);
@@ -286,7 +293,8 @@ Test(animation, frames_from_log)
 }
 
 /* A focus that follows look_at from frame to frame needs a field (render's default sampling)
-   a frame. */
+   a frame. The kept folder holds each field's POV-Ray logs, and develop makes each frame again
+   from its field's renders, which POV-Ray numbered by frame, byte for byte. */
 Test(animation, changing_focus_traces_again)
 {
     const char *dir = test_tmpdir();
@@ -304,6 +312,22 @@ Test(animation, changing_focus_traces_again)
     cr_expect_eq(count_entries(keep, "field.map", NULL, 0), 1);
     cr_expect_eq(count_entries(keep, "field.t1.map", NULL, 0), 1);
     cr_expect(file_exists(tmp_path(dir, "f1.png")) && file_exists(tmp_path(dir, "f2.png")));
+    char listing[1024];
+    cr_expect_eq(count_entries(keep, "povray.t1.", listing, sizeof listing), 2, "%s", listing);
+    cr_expect_eq(count_entries(keep, "povray.c", listing, sizeof listing), 2, "%s", listing);
+    const char *table[2] = {"field", "field.t1"};
+    for (int f = 0; f < 2; f++) {
+        char prefix[600], again[600], frame[32];
+        snprintf(prefix, sizeof prefix, "%s/%s", keep, table[f]);
+        snprintf(again, sizeof again, "%s/again%d.png", dir, f + 1);
+        snprintf(frame, sizeof frame, "f%d.png", f + 1);
+        cr_assert_eq(L2P(NULL, &errtext, "develop", prefix, "-o", again), 0, "%s", errtext);
+        free(errtext);
+        size_t na = 0, nb = 0;
+        char *a = read_text(again, &na), *b = read_text(tmp_path(dir, frame), &nb);
+        cr_expect(a && b && na == nb && !memcmp(a, b, na), "frame %d developed again differs", f + 1);
+        free(a), free(b);
+    }
 }
 
 /* Renders a scene of dir from its folder sub, given "--" ini (an .ini of sub, whose text is

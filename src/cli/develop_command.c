@@ -1,6 +1,7 @@
 /* `lens2pov develop`: POV-Ray's renders of a ray table into the picture. */
 #include "cli/commands.h"
 
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +17,103 @@ static bool exists(const char *path)
 {
     struct stat sb;
     return stat(path, &sb) == 0;
+}
+
+/* NAME.exr without its ".exr", with SUFFIX and ".exr" after it (malloc'd). */
+static char *with_suffix(const char *name, const char *suffix)
+{
+    const size_t stem = strlen(name) - 4;
+    char *s = malloc(stem + strlen(suffix) + 5);
+    if (s)
+        sprintf(s, "%.*s%s.exr", (int)stem, name, suffix);
+    return s;
+}
+
+/* Whether every render has a picture NAME<suffix>.exr. */
+static bool every_render_has(char *const *names, int count, const char *suffix)
+{
+    bool all = true;
+    for (int r = 0; all && r < count; r++) {
+        char *s = with_suffix(names[r], suffix);
+        all = s && exists(s);
+        free(s);
+    }
+    return all;
+}
+
+enum { MOST_FRAMES = 64 };
+
+/* The frame numbers F (as POV-Ray wrote them, padded) for which every render has NAMEF.exr:
+   the names in `frames` (malloc'd each); returns how many, at most MOST_FRAMES. */
+static int frames_present(char *const *names, int count, char *frames[MOST_FRAMES])
+{
+    const char *slash = strrchr(names[0], '/');
+    char *dir = slash ? strndup(names[0], (size_t)(slash - names[0] + 1)) : strdup(".");
+    const char *base = slash ? slash + 1 : names[0];
+    const size_t stem = strlen(base) - 4;
+    DIR *d = dir ? opendir(dir) : NULL;
+    int n = 0;
+    for (struct dirent *e; d && n < MOST_FRAMES && (e = readdir(d));) {
+        const char *rest = e->d_name + stem;
+        const size_t digits = strncmp(e->d_name, base, stem) ? 0 : strspn(rest, "0123456789");
+        if (!digits || strcmp(rest + digits, ".exr"))
+            continue;
+        char *frame = strndup(rest, digits);
+        if (frame && every_render_has(names, count, frame))
+            frames[n++] = frame;
+        else
+            free(frame);
+    }
+    if (d)
+        closedir(d);
+    free(dir);
+    for (int i = 1; i < n; i++)   /* by number: an insertion sort of a few */
+        for (int k = i; k > 0 && atoll(frames[k]) < atoll(frames[k - 1]); k--) {
+            char *t = frames[k];
+            frames[k] = frames[k - 1], frames[k - 1] = t;
+        }
+    return n;
+}
+
+/* POV-Ray numbers an animation's pictures by frame (povargs_frame_name): render NAME.exr of
+   frame F is NAMEF.exr. When the first render's own name is not there, the frames whose
+   pictures every render has: one (a frame with a table of its own) is developed; several are
+   refused, with the command that develops one of them. */
+static int frame_renders(const char *prefix, char **names, int count, l2p_error *err)
+{
+    if (count == 0 || exists(names[0]) || strlen(names[0]) < 4 ||
+        strcmp(names[0] + strlen(names[0]) - 4, ".exr"))
+        return L2P_OK;
+    char *frames[MOST_FRAMES];
+    const int n = frames_present(names, count, frames);
+    int st = L2P_OK;
+    if (n == 1) {
+        for (int r = 0; !st && r < count; r++) {
+            char *s = with_suffix(names[r], frames[0]);
+            if (!s)
+                st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+            else
+                free(names[r]), names[r] = s;
+        }
+    } else if (n > 1) {
+        char list[256] = "", example[1024] = "";
+        for (int i = 0; i < n && strlen(list) < 200; i++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%lld", i ? ", " : "",
+                     atoll(frames[i]));
+        for (int r = 0; r < count && r < 3; r++) {
+            char *s = with_suffix(names[r], frames[0]);
+            snprintf(example + strlen(example), sizeof example - strlen(example), " %s",
+                     s ? s : "");
+            free(s);
+        }
+        st = l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s: the renders are an animation's, POV-Ray "
+                      "numbering them by frame (frames %s): give one frame's %d render%s, as in "
+                      "lens2pov develop %s%s%s -o IMAGE", prefix, list, count, count == 1 ? "" : "s",
+                      prefix, example, count > 3 ? " ..." : "");
+    }
+    for (int i = 0; i < n; i++)
+        free(frames[i]);
+    return st;
 }
 
 /* Whether PREFIX.c000.EXT is there and PREFIX.EXT is not. */
@@ -52,9 +150,22 @@ static char **render_names(const cli *c, long long chunks, l2p_error *err)
         names[k] = given        ? strdup(c->positional[k + 1])
                    : chunks == 1 ? single_render_name(prefix)
                                  : chunk_file_name(prefix, (int)k, "exr");
-        if (!names[k])
-            break;
+        if (!names[k]) {
+            l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+            for (long long i = 0; i < k; i++)
+                free(names[i]);
+            free(names);
+            return NULL;
+        }
     }
+    if (names && !given && frame_renders(prefix, names, (int)chunks, err)) {
+        for (long long k = 0; k < chunks; k++)
+            free(names[k]);
+        free(names);
+        return NULL;
+    }
+    if (!names)
+        l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     return names;
 }
 
@@ -109,7 +220,9 @@ static int develop_field(const cli *c, const char *map_path, l2p_error *err)
     }
     if (!names || (m.renders && !names[m.renders - 1]))
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    else if (!(st = check_inputs(c, map_path, names, m.renders, err)))
+    else if (!given)
+        st = frame_renders(prefix, names, m.renders, err);
+    if (!st && !(st = check_inputs(c, map_path, names, m.renders, err)))
         st = field_develop(&m, (const char *const *)names, given ? given : m.renders, c->output,
                            err);
     for (int r = 0; names && r < m.renders; r++)

@@ -297,6 +297,8 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
                             outfile *csv, const table_frames *tf, int table, l2p_error *err)
 {
     writer w = {.cam = cam, .c = c, .total = -1, .frames = tf->count, .with_csv = table == 0};
+    char runs[32];   /* the POV-Ray runs' files of a table after the first */
+    snprintf(runs, sizeof runs, "povray.t%d", table);
     if (table == 0)
         snprintf(w.prefix, sizeof w.prefix, "%s/rays", ws->dir);
     else
@@ -332,7 +334,7 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
                                    !c->quiet, NULL, chunks_ready, &w, c->povray_args,
                                    c->povray_arg_count, c->cam.width, c->cam.height,
                                    load_image_library, NULL, frame_picture_done, &d, ws->keep,
-                                   NULL};
+                                   table ? runs : NULL};
         if (!st)
             st = povray_render_chunks(pc, count * tf->count, &po, err);
         if (st)
@@ -380,11 +382,12 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     for (int i = 0; i < tf->count; i++)
         fr[i] = (field_frame){tf->frame[i]->output, tf->frame[i]->placement, tf->frame[i]->number};
-    char prefix[8192];
+    char prefix[8192], runs[32];
     if (table == 0)
         snprintf(prefix, sizeof prefix, "%s/field", ws->dir);
     else
         snprintf(prefix, sizeof prefix, "%s/field.t%d", ws->dir, table);
+    snprintf(runs, sizeof runs, "povray.t%d", table);
     const bool with_csv = c->rays_csv && table == 0;
     bool too_fine = false;
     const field_render_options fo = {c->positional[0], ws->dir, prefix, fr, tf->count, tf->digits,
@@ -392,7 +395,7 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
                                      !c->quiet, c->field_tolerance,
                                      c->adaptive && adaptive_fits(c, cam),
                                      with_csv ? csv : NULL, &too_fine, load_image_library,
-                                     ws->keep};
+                                     ws->keep, table ? runs : NULL};
     const int st = field_render(cam, &fo, err);
     free(fr);
     if (st == L2P_BAD_INPUT && too_fine && !c->sampling_chosen) {

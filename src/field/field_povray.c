@@ -227,7 +227,8 @@ int field_render(const camera *c, const field_render_options *o, l2p_error *err)
                                .show_progress = o->progress, .user_args = o->povray_args,
                                .user_arg_count = o->povray_arg_count,
                                .started = o->povray_started, .work_dir_kept = o->work_dir_kept,
-                               .film_width = c->film.width, .film_height = c->film.height};
+                               .film_width = c->film.width, .film_height = c->film.height,
+                               .file_name = o->povray_file_name};
     const bool still = o->frame_count == 1 && o->frames[0].number < 0;
     const bool one_run_a_job = !o->povray_args && still;
     bool too_fine = false;

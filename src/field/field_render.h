@@ -40,6 +40,7 @@ typedef struct field_render_options {
                                   NULL: not asked */
     void (*povray_started)(void *ctx);   /* povray_options.started's, with no context */
     bool work_dir_kept;        /* povray_options.work_dir_kept's */
+    const char *povray_file_name;   /* povray_options.file_name's: the POV-Ray runs' files */
 } field_render_options;
 
 /* --field-tolerance's default, in pixels: no picture shows an error this small. */
