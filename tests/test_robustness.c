@@ -114,6 +114,10 @@ static const bad_line BAD_OPTIONS[] = {
      "--aperture-diameter and --f-number"},
     {{"trace", DGAUSS, "--rays", "OUT.inc", "-o", "OUT"}, "--rays"},
     {{"trace", DGAUSS, "--rays", "OUT.map", "-o", "OUT"}, "--rays"},
+    {{"trace", DGAUSS, "--rays", "OUT.exr", "-o", "OUT"}, "--rays"},
+    {{"trace", DGAUSS, "--sampling", "field", "--rays", "OUT.f000.inc", "-o", "OUT"}, "--rays"},
+    {{"trace", DGAUSS, "--sampling", "field", "--rays", "OUT.f001.exr", "-o", "OUT"}, "--rays"},
+    {{"trace", DGAUSS, "--memory-mb", "1", "--rays", "OUT.c000.ini", "-o", "OUT"}, "--rays"},
     /* placement */
     {{"trace", DGAUSS, "--location", "1,2", "-o", "OUT"}, "--location"},
     {{"trace", DGAUSS, "--location", "1,2,nan", "-o", "OUT"}, "--location"},
@@ -121,6 +125,8 @@ static const bad_line BAD_OPTIONS[] = {
     {{"trace", DGAUSS, "--look-at", "0,0,0", "-o", "OUT"}, "--look-at"},
     {{"trace", DGAUSS, "--sky", "0,0,1", "-o", "OUT"}, "--sky must not be parallel"},
     {{"trace", DGAUSS, "--sky", "0,0,0", "-o", "OUT"}, "--sky must be a direction"},
+    {{"trace", DGAUSS, "--location", "0,0,-1e308", "--look-at", "0,0,1e308", "-o", "OUT"},
+     "too far apart"},
     {{"trace", DGAUSS, "--unit-mm", "0", "-o", "OUT"}, "--unit-mm"},
     {{"trace", DGAUSS, "--unit-mm", "-1000", "-o", "OUT"}, "--unit-mm"},
     {{"trace", DGAUSS, "--seed", "-1", "-o", "OUT"}, "--seed"},
@@ -195,25 +201,22 @@ ParameterizedTest(size_t *row, robustness, bad_command_lines_are_refused)
 {
     const bad_line *b = &BAD_OPTIONS[*row];
     const char *dir = test_tmpdir();
-    char out[512], outexr[512], outinc[512], outmap[512], scene[512], jpg[512];
+    char out[512], outexr[512], scene[512], named[16][512];
     snprintf(out, sizeof out, "%s/p", dir);
     snprintf(outexr, sizeof outexr, "%s/p.exr", dir);
-    snprintf(outinc, sizeof outinc, "%s/p.inc", dir);
-    snprintf(outmap, sizeof outmap, "%s/p.map", dir);
     snprintf(scene, sizeof scene, "%s/scene.pov", dir);
-    snprintf(jpg, sizeof jpg, "%s/p.jpg", dir);
     write_text(scene, "#version 3.7;\nbackground { rgb 1 }\n");
     char *w[16] = {0};
     char line[1024] = "";
     for (int k = 0; k < 15 && b->words[k]; k++) {
         const char *x = b->words[k];
-        w[k] = !strcmp(x, "OUT")       ? out
-               : !strcmp(x, "OUTEXR")  ? outexr
-               : !strcmp(x, "OUT.inc") ? outinc
-               : !strcmp(x, "OUT.map") ? outmap
-               : !strcmp(x, "OUT.jpg") ? jpg
-               : !strcmp(x, "SCENE")   ? scene
-                                       : (char *)x;
+        if (!strncmp(x, "OUT.", 4))   /* OUT.EXT: p.EXT in the folder */
+            snprintf(named[k], sizeof named[k], "%s/p%s", dir, x + 3);
+        w[k] = !strcmp(x, "OUT")           ? out
+               : !strcmp(x, "OUTEXR")      ? outexr
+               : !strncmp(x, "OUT.", 4)    ? named[k]
+               : !strcmp(x, "SCENE")       ? scene
+                                           : (char *)x;
         strncat(line, x, sizeof line - strlen(line) - 2);
         strcat(line, " ");
     }
@@ -233,6 +236,18 @@ ParameterizedTest(size_t *row, robustness, bad_command_lines_are_refused)
     free(errtext);
     free(outtext);
     remove_tree(dir);
+}
+
+/* A look-at point 1e155 away is far, not a sky along the view: the direction's squared
+   length overflowed and the sky was refused as parallel to it. */
+Test(robustness, a_far_look_at_point_is_a_direction)
+{
+    char *errtext = NULL, *outtext = NULL;
+    cr_expect_eq(run_lens2pov(&outtext, &errtext, "info", DGAUSS, "--look-at", "0,0.5,1e155",
+                              "--json", NULL), 0, "%s", errtext);
+    cr_expect(outtext && strstr(outtext, "\"hfov_deg\": 31."), "%s", outtext ? outtext : "");
+    free(errtext);
+    free(outtext);
 }
 
 /* ---------------------------------------------------------------- malformed lens files */

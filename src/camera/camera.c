@@ -26,16 +26,26 @@ void camera_options_default(camera_options *o)
     o->weighting = WEIGHTING_NORMALIZED;
 }
 
+/* The largest component's size: a vector scaled by its inverse has a length between 1 and
+   sqrt(3), whose square neither overflows nor underflows (a look-at point 1e155 away would). */
+static double largest(vec3 v)
+{
+    return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
+}
+
 static int setup_placement(camera *c, const camera_options *o, l2p_error *err)
 {
     const vec3 ahead = v3_sub(o->look_at, o->location);
-    if (!(v3_length(ahead) > 0.0))
+    if (!(largest(ahead) > 0.0))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--look-at must differ from --location");
-    c->forward = v3_normalize(ahead);
-    if (!(v3_length(o->sky) > 0.0) || !v3_isfinite(o->sky))
+    if (!isfinite(largest(ahead)))
+        return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--look-at and --location are too far apart "
+                        "for double precision");
+    c->forward = v3_normalize(v3_scale(ahead, 1.0 / largest(ahead)));
+    if (!(largest(o->sky) > 0.0) || !v3_isfinite(o->sky))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--sky must be a direction: not 0,0,0");
-    const vec3 side = v3_cross(o->sky, c->forward);
-    if (!(v3_length(side) > 1e-12 * v3_length(o->sky)))
+    const vec3 side = v3_cross(v3_scale(o->sky, 1.0 / largest(o->sky)), c->forward);
+    if (!(v3_length(side) > 1e-12))
         return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                         "--sky must not be parallel to the viewing direction");
     c->right = v3_normalize(side);

@@ -4,6 +4,7 @@
 #include "cli/values.h"
 #include "field/field_render.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -309,13 +310,23 @@ static int value_option(cli *c, const char *opt, const char *v, l2p_error *err)
     return st;
 }
 
-/* --rays naming one of the other outputs: both would be renamed into place, the last wins. */
+/* --rays naming one of the other outputs (the table, its chunks, a field's renders, or the
+   pictures POV-Ray is to write for them): both would be renamed into place, the last wins. */
 static bool same_output(const char *rays, const char *output)
 {
-    static const char *const ext[] = {"", ".inc", ".ini", ".map"};
+    static const char *const ext[] = {".inc", ".ini", ".map", ".exr"};
     const size_t n = strlen(output);
+    if (strncmp(rays, output, n))
+        return false;
+    const char *rest = rays + n;
+    if (!*rest)
+        return true;
+    /* a chunk's or a field render's files: PREFIX.cNNN.EXT, PREFIX.fNNN.EXT */
+    if (rest[0] == '.' && (rest[1] == 'c' || rest[1] == 'f') && isdigit((unsigned char)rest[2]))
+        for (rest += 2; isdigit((unsigned char)*rest); rest++)
+            continue;
     for (int i = 0; i < 4; i++)
-        if (!strncmp(rays, output, n) && !strcmp(rays + n, ext[i]))
+        if (!strcmp(rest, ext[i]))
             return true;
     return false;
 }
