@@ -55,15 +55,21 @@ static double interpolate(const double at[FIELD_STRATA_WAVELENGTHS], double nm)
 /* Directions over which the passing share of the disk on the axis is integrated. */
 enum { AXIS_DIRECTIONS = 512 };
 
-/* Whether the film's centre passes the pupil sample at radius r on the unit disk's x axis. */
-static bool axis_passes(const camera *c, double r, double nm, sample_batch *b)
+/* Whether the film's centre passes pupil sample (u, v) of the unit square at wavelength nm. */
+static bool passes_at_centre(const camera *c, double u, double v, double nm, sample_batch *b)
 {
     b->n = 1;
     b->film_point[0] = v3(0.0, 0.0, 0.0);
-    b->u[0] = 0.5 * (r + 1.0), b->v[0] = 0.5;
+    b->u[0] = u, b->v[0] = v;
     b->wavelength_nm[0] = nm;
     camera_trace_batch(c, b);
     return b->passed[0];
+}
+
+/* Whether it passes the pupil sample at radius r on the unit disk's x axis. */
+static bool axis_passes(const camera *c, double r, double nm, sample_batch *b)
+{
+    return passes_at_centre(c, 0.5 * (r + 1.0), 0.5, nm, b);
 }
 
 /* c(nm): the passing disk's radius on the unit disk, bisected to 1e-12; 0 when the axis's own
@@ -117,12 +123,7 @@ static double axis_share_at(const camera *c, double nm, sample_batch *b)
 /* Whether shared sample s passes on the axis. */
 static bool passes_on_axis(const camera *c, film_sample s, sample_batch *b)
 {
-    b->n = 1;
-    b->film_point[0] = v3(0.0, 0.0, 0.0);
-    b->u[0] = s.pupil_u, b->v[0] = s.pupil_v;
-    b->wavelength_nm[0] = s.wavelength_nm;
-    camera_trace_batch(c, b);
-    return b->passed[0];
+    return passes_at_centre(c, s.pupil_u, s.pupil_v, s.wavelength_nm, b);
 }
 
 /* The share of a stratum averaged over the wavelengths' sampling density, lambda = P^-1(u) for

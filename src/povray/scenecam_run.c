@@ -304,6 +304,18 @@ static void probe_error(const char *scene, const char *dir, const char *top, con
     free(links);
 }
 
+/* run_probe, started again while it fails for a passing cause, as a render's runs are. */
+static int run_probe_again(const char *dir, const char *input, const char *log, int w, int h,
+                           const probe_args *pa, l2p_error *err)
+{
+    int st;
+    for (int retries = 0;; retries++) {
+        st = run_probe(dir, input, log, w, h, pa, err);
+        if (st >= 0 || !povray_retry_transient(log, retries))
+            return st;
+    }
+}
+
 /* After the copy failed: POV-Ray on the scene as it is. When that fails too, its error is the
    scene's, named in the user's own files; when it does not, the copy's camera statement, which
    prints each item, is what POV-Ray could not read (an item that a macro gives, say), and the
@@ -318,12 +330,7 @@ static void copy_or_scene_error(const char *scene, const char *dir, const char *
     else
         snprintf(abs, sizeof abs, "%s/%s", cwd, scene);
     l2p_error alone;
-    int st;
-    for (int retries = 0;; retries++) {
-        st = run_probe(dir, abs, log, w, h, pa, &alone);
-        if (st >= 0 || !povray_retry_transient(log, retries))
-            break;
-    }
+    const int st = run_probe_again(dir, abs, log, w, h, pa, &alone);
     const povray_log_names names = {scene, dir, {NULL, NULL}, NULL, 0};
     if (st < 0 && povray_log_error(log, &names, &alone))
         *err = alone;
@@ -346,11 +353,7 @@ static int run_copy(const char *scene, const char *dir, const char *work, int w,
     snprintf(log, sizeof log, "%s/scene-camera.log", work);
     int st = write_probe_files(work, sc->text, copy, top, sizeof copy, err);
     if (!st) {
-        for (int retries = 0;; retries++) {   /* as a render's runs are started again */
-            st = run_probe(dir, top, log, w, h, pa, err);
-            if (st >= 0 || !povray_retry_transient(log, retries))
-                break;
-        }
+        st = run_probe_again(dir, top, log, w, h, pa, err);
         if (st < 0 && pa->user_count && refused_options(log, pa, err))
             st = L2P_BAD_INPUT;
         if (st < 0) {
