@@ -774,9 +774,21 @@ Test(image_io, read_errors)
     FILE *fp = fopen(junk, "wb");
     fputs("not an image\n", fp);
     fclose(fp);
-    cr_assert_eq(image_read_rgba(junk, &w, &h, &px, &err), L2P_FAILED);
+    cr_assert_eq(image_read_rgba(junk, &w, &h, &px, &err), L2P_BAD_INPUT);
     cr_assert(strstr(err.text, junk), "%s", err.text);
     cr_assert_null(strchr(err.text, '\n'), "%s", err.text);
+    cr_assert_null(px);
+    /* a picture cut short: its header reads, its pixels do not */
+    const char *cut = tmp_path(dir, "cut.exr");
+    float rgb[3 * 64 * 64];
+    for (int i = 0; i < 3 * 64 * 64; i++)   /* noise, so that compression leaves bytes to cut */
+        rgb[i] = (float)((i * 7919) % 1000) / 1000.0f;
+    cr_assert_eq(image_write_rgb(cut, 64, 64, rgb, NULL, 0, &err), L2P_OK, "%s", err.text);
+    struct stat sb;
+    cr_assert_eq(stat(cut, &sb), 0);
+    cr_assert_eq(truncate(cut, sb.st_size / 2), 0);
+    cr_assert_eq(image_read_rgba(cut, &w, &h, &px, &err), L2P_BAD_INPUT);
+    cr_assert(strstr(err.text, cut), "%s", err.text);
     cr_assert_null(px);
 }
 

@@ -485,7 +485,7 @@ Test(pupil, film_points_no_ray_can_reach_produce_no_samples)
     free(rows);
 }
 
-Test(pupil, the_stop_pupil_says_it_is_biased)
+Test(pupil, the_stop_pupil_says_its_pictures_are_biased)
 {
     const char *dir = test_tmpdir();
     char *errtext;
@@ -494,6 +494,16 @@ Test(pupil, the_stop_pupil_says_it_is_biased)
                           tmp_path(dir, "s"), "--quiet", NULL);
     cr_assert_eq(st, 0, "%s", errtext);
     cr_assert(strstr(errtext, "warning: --pupil stop") != NULL, "%s", errtext);
+    free(errtext);
+    /* info, the diagram and the plot make no picture: their figures do not use the pupil */
+    st = run_lens2pov(NULL, &errtext, "info", LENS_DIR "dgauss.50mm.dat", "--pupil", "stop", NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    cr_expect_str_empty(errtext);
+    free(errtext);
+    st = run_lens2pov(NULL, &errtext, "diagram", LENS_DIR "dgauss.50mm.dat", "--pupil", "stop",
+                      "-o", tmp_path(dir, "d.svg"), NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    cr_expect_str_empty(errtext);
     free(errtext);
 }
 

@@ -70,7 +70,7 @@ static const bad_line BAD_OPTIONS[] = {
     {{"trace", DGAUSS, "--width", "abc", "-o", "OUT"}, "--width"},
     {{"trace", DGAUSS, "--width", "1.5", "-o", "OUT"}, "--width"},
     {{"trace", DGAUSS, "--width", "", "-o", "OUT"}, "--width"},
-    {{"trace", DGAUSS, "--width", "99999999999", "-o", "OUT"}, "--width"},
+    {{"trace", DGAUSS, "--width", "99999999999", "-o", "OUT"}, "at most 2147483647"},
     {{"trace", DGAUSS, "--width=0", "-o", "OUT"}, "--width"},
     {{"trace", DGAUSS, "--height", "0", "-o", "OUT"}, "--height"},
     {{"trace", DGAUSS, "--height", "-1", "-o", "OUT"}, "--height"},
@@ -174,6 +174,11 @@ static const bad_line BAD_OPTIONS[] = {
     {{"develop", "OUT", "--spp", "4", "-o", "OUTEXR"}, "develop does not take --spp"},
     {{"render", "SCENE", DGAUSS, "--json", "-o", "OUTEXR"}, "render does not take --json"},
     {{"info", DGAUSS, "--json=1"}, "--json"},
+    /* a value forgotten: the next option is not taken for it */
+    {{"plot", DGAUSS, "--what", "-o", "OUT.png"}, "--what needs a value, not the option -o"},
+    {{"trace", DGAUSS, "--spp", "--quiet", "-o", "OUT"}, "--spp needs a value, not the option"},
+    {{"diagram", DGAUSS, "-o", ".svg"}, "no file name before .svg"},
+    {{"--version", "extra"}, "--version takes nothing"},
 };
 
 /* The parameters of a test a row: row numbers, in Criterion's shared memory (a test's process

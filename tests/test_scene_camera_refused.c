@@ -186,3 +186,27 @@ Test(scene_camera, an_included_cameras_faults_name_its_file)
     cr_expect_eq(st, 0, "%s", errtext ? errtext : "");
     free(errtext);
 }
+
+/* A camera statement without its '}' is the scene's fault, whether its items are literals
+   (read without POV-Ray) or not: trace --scene is refused (exit 2) with POV-Ray's own message
+   at the statement, not traced with the items read so far. */
+Test(scene_camera, an_unclosed_camera_is_the_scenes_fault)
+{
+    static const char *const scenes[] = {
+        "#version 3.7;\ncamera { location <0, 1, -5> look_at <0, 1, 0>\n",
+        "camera { location 5 look_at 0\n",
+    };
+    for (int k = 0; k < 2; k++) {
+        const char *dir = test_tmpdir();
+        const char *scene = tmp_path(dir, "open.pov");
+        write_text(scene, scenes[k]);
+        char *errtext = NULL;
+        const int st = L2P(NULL, &errtext, "trace", DGAUSS, "--scene", scene, SIZE, "--spp", "1",
+                           "-q", "-o", tmp_path(dir, "t"));
+        cr_expect_eq(st, 2, "scene %d: exit %d: %s", k, st, errtext ? errtext : "");
+        cr_expect(errtext && strstr(errtext, scene) && strstr(errtext, "No matching }"),
+                  "scene %d: %s", k, errtext ? errtext : "");
+        cr_expect_not(file_exists(tmp_path(dir, "t.map")));
+        free(errtext);
+    }
+}

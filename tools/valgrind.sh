@@ -94,7 +94,7 @@ run 2 "render of an animation into a missing folder" render "$work/plain.pov" "$
 # The probe: develop loads the image library, which then refuses a file that is not an image.
 echo "not an image" >"$work/junk.exr"
 probing=1
-run 1 "develop of a file that is not an image" develop "$work/t" "$work/junk.exr" -o "$work/j.png"
+run 2 "develop of a file that is not an image" develop "$work/t" "$work/junk.exr" -o "$work/j.png"
 probing=0
 skipped=0
 if image_library_unusable; then

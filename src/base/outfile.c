@@ -83,9 +83,12 @@ char *outfile_target(const char *path)
 
 int outfile_check_suffix(const char *path, const char *suffix, const char *format, l2p_error *err)
 {
-    const size_t n = strlen(path), k = strlen(suffix);
-    if (n > k && !strcasecmp(path + n - k, suffix))
+    const char *slash = strrchr(path, '/'), *name = slash ? slash + 1 : path;
+    const size_t n = strlen(name), k = strlen(suffix);
+    if (n > k && !strcasecmp(name + n - k, suffix))
         return L2P_OK;
+    if (n == k && !strcasecmp(name, suffix))
+        return l2p_fail(err, L2P_BAD_INPUT, path, 0, "no file name before %s", suffix);
     return l2p_fail(err, L2P_BAD_INPUT, path, 0, "this command writes %s: give a name ending in %s", format,
                     suffix);
 }

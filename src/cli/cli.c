@@ -105,9 +105,12 @@ static const cli_option OPTIONS[] = {
      "  --spp N                       samples per pixel [16]\n"},
     {"--film-diagonal", NULL, CMD_CAMERA, false, true,
      "  --film-diagonal MM            [35]\n"},
-    {"--angle", NULL, CMD_CAMERA, false, true,
+    {"--angle", NULL, CMD_SAMPLES, false, true,
      "  --angle DEG|scene             film width for this horizontal field of view, traced\n"
      "                                (scene: the scene camera's angle) [--film-diagonal]\n"},
+    {"--angle", NULL, CMD_CAMERA & ~CMD_SAMPLES, false, true,
+     "  --angle DEG                   film width for this horizontal field of view, traced\n"
+     "                                [--film-diagonal]\n"},
     {"--crop", NULL, CMD_SAMPLES, false, true,
      "  --crop X0,Y0,X1,Y1            a region of the film (X1, Y1 exclusive) [the whole film]\n"},
     {"--film-distance", NULL, CMD_CAMERA, false, true,
@@ -440,6 +443,13 @@ static const cli_option *find_option(unsigned command, const char *cmd_name, con
     return NULL;
 }
 
+/* No value starts with "--", and "-o" or "-q" after an option that wants a value is the next
+   option, the value forgotten; "-5" is a number. */
+static bool looks_like_option(const char *v)
+{
+    return (v[0] == '-' && v[1] == '-') || (v[0] == '-' && isalpha((unsigned char)v[1]) && !v[2]);
+}
+
 int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
 {
     memset(c, 0, sizeof *c);
@@ -489,6 +499,9 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err)
             if (i + 1 >= argc)
                 return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s needs a value", opt);
             value = argv[++i];
+            if (looks_like_option(value))
+                return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s needs a value, not the option %s",
+                                opt, value);
         }
         c->film_given |= o->camera;   /* info prints the camera only when asked for one */
         int st = value_option(c, o->name, value, err);
@@ -515,7 +528,7 @@ void cli_print_options(FILE *out, const char *command)
     }
 }
 
-void cli_warn(const cli *c, const camera *cam)
+void cli_warn(const cli *c, const camera *cam, bool picture)
 {
     /* A film nearer the lens than its focal plane images a virtual object: nothing in front of
        the lens is sharp. */
@@ -523,6 +536,8 @@ void cli_warn(const cli *c, const camera *cam)
         fprintf(stderr, "lens2pov: warning: --film-distance %g mm focuses %g units behind the "
                         "film: nothing in the scene is sharp\n", c->cam.film_distance_mm,
                 -cam->focus_distance_units);
+    if (!picture)
+        return;
     if (c->cam.pupil == PUPIL_STOP && c->cam.trace == TRACE_KIND_FULL)
         fprintf(stderr, "lens2pov: warning: --pupil stop aims at the stop's own disk, which misses "
                         "rays the lens passes and holds rays it blocks: the picture is biased (with "

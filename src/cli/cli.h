@@ -45,9 +45,10 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
 /* The lines of COMMAND --help that list its options: the same table the parser accepts. */
 void cli_print_options(FILE *out, const char *command);
 
-/* Warns on stderr about choices that give a picture the user may not expect: --pupil stop
-   (biased on purpose), a film distance that puts the focus behind the camera. */
-void cli_warn(const cli *c, const camera *cam);
+/* Warns on stderr about choices that give a picture the user may not expect: a film distance
+   that puts the focus behind the camera, and for a command that makes a picture (trace and
+   render), --pupil stop (biased on purpose) and a stop where diffraction would show. */
+void cli_warn(const cli *c, const camera *cam, bool picture);
 
 /* L2P_BAD_INPUT unless c has exactly `positional` arguments and, when output, a -o. */
 int cli_expect_arguments(const cli *c, int positional, bool output, l2p_error *err);

@@ -116,22 +116,62 @@ static int frame_renders(const char *prefix, char **names, int count, l2p_error 
     return st;
 }
 
-/* Whether PREFIX.c000.EXT is there and PREFIX.EXT is not. */
-static bool only_chunked(const char *prefix, const char *ext)
+static bool newer(const struct stat *a, const struct stat *b)
+{
+    return a->st_mtim.tv_sec != b->st_mtim.tv_sec ? a->st_mtim.tv_sec > b->st_mtim.tv_sec
+                                                  : a->st_mtim.tv_nsec > b->st_mtim.tv_nsec;
+}
+
+/* Which of PREFIX.EXT (0) and PREFIX.c000.EXT (1) is there, the newer when both are (an
+   earlier trace of the same prefix left the other); -1 when neither is. */
+static int chunked_file(const char *prefix, const char *ext)
 {
     char *one = povmesh_chunk_file(prefix, false, 0, ext), *chunk = chunk_file_name(prefix, 0, ext);
-    const bool only = one && chunk && !exists(one) && exists(chunk);
+    struct stat o, c;
+    const bool has_one = one && stat(one, &o) == 0, has_chunk = chunk && stat(chunk, &c) == 0;
     free(one), free(chunk);
-    return only;
+    if (has_one && has_chunk)
+        return newer(&c, &o);
+    return has_chunk ? 1 : has_one ? 0 : -1;
 }
 
 /* The render of a table of one chunk: PREFIX.exr, or PREFIX.c000.exr when the trace was asked
-   for chunks (--memory-mb) and one was enough; the .ini beside the map says which, else the
-   render that is there. */
+   for chunks (--memory-mb) and one was enough. The .ini the trace wrote beside the map says
+   which; without one, the render that is there. */
 static char *single_render_name(const char *prefix)
 {
-    const bool chunked = only_chunked(prefix, "ini") || only_chunked(prefix, "exr");
-    return povmesh_chunk_file(prefix, chunked, 0, "exr");
+    int chunked = chunked_file(prefix, "ini");
+    if (chunked < 0)
+        chunked = chunked_file(prefix, "exr");
+    return povmesh_chunk_file(prefix, chunked == 1, 0, "exr");
+}
+
+/* Whether NAME is, by the names the .ini files give POV-Ray, render K of kind KIND ('c' for a
+   chunk, 'f' for a field render): ".c" and K in three digits or more, then the frame number POV-Ray
+   adds in an animation, if any, then ".exr". */
+static bool named_as_render(const char *name, char kind, int k)
+{
+    char tag[24];
+    snprintf(tag, sizeof tag, ".%c%03d", kind, k);
+    for (const char *p = strstr(name, tag); p; p = strstr(p + 1, tag)) {
+        const char *rest = p + strlen(tag);
+        if (!strcmp(rest + strspn(rest, "0123456789"), ".exr"))
+            return true;
+    }
+    return false;
+}
+
+/* Given renders are taken in order, and nothing in a render tells its chunk: a name that is
+   another place's and not its own is refused rather than developed into a wrong picture. */
+static int check_given_order(char *const *names, int count, char kind, l2p_error *err)
+{
+    for (int r = 0; r < count; r++)
+        for (int k = 0; k < count && !named_as_render(names[r], kind, r); k++)
+            if (k != r && named_as_render(names[r], kind, k))
+                return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "%s is given as render %d but named "
+                                "as render %d: give the renders in the order of their numbers",
+                                names[r], r, k);
+    return L2P_OK;
 }
 
 /* The renders of the chunks: as given, or by the names the chunks' .ini files give POV-Ray
@@ -158,7 +198,8 @@ static char **render_names(const cli *c, long long chunks, l2p_error *err)
             return NULL;
         }
     }
-    if (names && !given && frame_renders(prefix, names, (int)chunks, err)) {
+    if (names && (given ? check_given_order(names, (int)chunks, 'c', err)
+                        : frame_renders(prefix, names, (int)chunks, err))) {
         for (long long k = 0; k < chunks; k++)
             free(names[k]);
         free(names);
@@ -178,9 +219,7 @@ static void warn_older(const char *map_path, char *const *renders, long long cou
     if (stat(map_path, &map) != 0)
         return;
     for (long long k = 0; k < count; k++)
-        if (renders[k] && stat(renders[k], &r) == 0 &&
-            (r.st_mtim.tv_sec < map.st_mtim.tv_sec ||
-             (r.st_mtim.tv_sec == map.st_mtim.tv_sec && r.st_mtim.tv_nsec < map.st_mtim.tv_nsec)))
+        if (renders[k] && stat(renders[k], &r) == 0 && newer(&map, &r))
             fprintf(stderr, "lens2pov: warning: %s is older than %s: was it rendered from an earlier "
                     "trace? (render the trace's .ini again)\n", renders[k], map_path);
 }
@@ -220,8 +259,9 @@ static int develop_field(const cli *c, const char *map_path, l2p_error *err)
     }
     if (!names || (m.renders && !names[m.renders - 1]))
         st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    else if (!given)
-        st = frame_renders(prefix, names, m.renders, err);
+    else
+        st = given ? check_given_order(names, given, 'f', err)
+                   : frame_renders(prefix, names, m.renders, err);
     if (!st && !(st = check_inputs(c, map_path, names, m.renders, err)))
         st = field_develop(&m, (const char *const *)names, given ? given : m.renders, c->output,
                            err);

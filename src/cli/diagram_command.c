@@ -12,7 +12,7 @@ int diagram_command(const cli *c, l2p_error *err)
     if (st || (st = outfile_check_suffix(c->output, ".svg", "SVG", err)) || (st = outfile_check_path(c->output, err)) ||
         (st = framing_load_camera(c, c->positional[0], &cam, err)))
         return st;
-    cli_warn(c, &cam);
+    cli_warn(c, &cam, false);
     outfile f;
     if (!(st = outfile_open(&f, c->output, err))) {
         st = diagram_write_svg(f.fp, &cam, err);

@@ -174,7 +174,7 @@ int info_command(const cli *c, l2p_error *err)
             camera_free(&cam);
     }
     if (!st && with_camera)
-        cli_warn(c, &cam);
+        cli_warn(c, &cam, false);
     if (!st)
         info_print(stdout, &l, &li, with_camera ? &cam : NULL, c->cam.wavelength_nm, c->json);
     if (with_camera && !st)

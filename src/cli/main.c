@@ -76,6 +76,10 @@ int main(int argc, char **argv)
         return argc < 2 ? L2P_BAD_INPUT : L2P_OK;
     }
     if (!strcmp(argv[1], "--version")) {
+        if (argc > 2) {
+            fprintf(stderr, "lens2pov: --version takes nothing after it, got '%s'\n", argv[2]);
+            return L2P_BAD_INPUT;
+        }
         puts("lens2pov " LENS2POV_VERSION);
         return L2P_OK;
     }

@@ -33,7 +33,7 @@ static int load_cameras(const cli *c, bool vignetting, plot_job *j, l2p_error *e
     if (st)
         return st;
     j->count = 1;
-    cli_warn(c, &j->cams[0]);
+    cli_warn(c, &j->cams[0], false);
     for (int i = 0; vignetting && i < 3; i++) {
         if (!(STOPS[i] > 1.01 * j->cams[0].f_number))
             continue;

@@ -425,7 +425,7 @@ static int render_table(const render_frames *rf, int t, const workspace *ws, int
     if (!st) {
         if (!(st = framing_camera_setup(&cam, &l, c, err))) {
             if (t == 0)
-                cli_warn(c, &cam);
+                cli_warn(c, &cam, true);
             st = c->field_sampling ? field_and_render(c, &cam, ws, jobs, csv, &tf, t, err)
                                    : trace_and_render(c, &cam, ws, jobs, csv, &tf, t, err);
         }

@@ -80,7 +80,7 @@ int trace_command(const cli *given, l2p_error *err)
         (c->scene && (st = framing_from_scene(&placed, c->scene, err))) ||
         (st = framing_load_camera(c, c->positional[0], &cam, err)))
         return st;
-    cli_warn(c, &cam);
+    cli_warn(c, &cam, true);
     if (c->field_sampling) {
         st = trace_field(c, &cam, err);
         camera_free(&cam);

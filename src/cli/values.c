@@ -83,7 +83,7 @@ bool value_crop(const char *s, int crop[4])
 int value_positive_int(const char *opt, const char *v, int *out, l2p_error *err)
 {
     if (!value_int(v, out) || *out <= 0)
-        return value_bad(err, opt, "a positive whole number", v);
+        return value_bad(err, opt, "a positive whole number, at most 2147483647", v);
     return L2P_OK;
 }
 

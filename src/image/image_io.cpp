@@ -166,11 +166,12 @@ int read_rgba(const char *path, int *width, int *height, float **pixels, l2p_err
     ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
     auto in = ImageInput::open(path, &config);
+    // A file that is there but cannot be decoded is bad input (exit 2), as a bad lens file is.
     if (!in)
-        return fail(err, L2P_FAILED, path, OIIO::geterror());
+        return fail(err, L2P_BAD_INPUT, path, OIIO::geterror());
     const ImageSpec spec = in->spec();
     if (spec.deep || spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-        return fail(err, L2P_FAILED, path, "not a flat image with pixels");
+        return fail(err, L2P_BAD_INPUT, path, "not a flat image with pixels");
     const size_t n = (size_t)spec.width * spec.height;
     const bool in_place = spec.nchannels <= 4;
     std::vector<float> other(in_place ? 0 : n * spec.nchannels);
@@ -180,7 +181,7 @@ int read_rgba(const char *path, int *width, int *height, float **pixels, l2p_err
     float *src = in_place ? out : other.data();
     if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, src)) {
         std::free(out);
-        return fail(err, L2P_FAILED, path, in->geterror());
+        return fail(err, L2P_BAD_INPUT, path, in->geterror());
     }
     convert_to_rgba(spec, src, out);
     *width = spec.width;

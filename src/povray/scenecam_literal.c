@@ -169,9 +169,9 @@ char *scene_camera_literal_log(const char *s, size_t n)
         if (lex_walk_directive(&w))
             ok = follow_directive(&w, &depth, &version);
         if (ok && lex_walk_camera(&w, &open, &close)) {
-            ok = depth == 0 && version >= 3.5 && version <= 3.7 &&
-                 literal_camera(&t, s, open, close > open ? close - 1 : open, index++, w.line,
-                                version);
+            /* An unclosed camera is left to the probe, whose POV-Ray says where. */
+            ok = depth == 0 && version >= 3.5 && version <= 3.7 && s[close - 1] == '}' &&
+                 literal_camera(&t, s, open, close - 1, index++, w.line, version);
             lex_walk_past(&w, close);
         }
     }

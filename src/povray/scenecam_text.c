@@ -251,7 +251,14 @@ char *scene_camera_rewrite_file(const char *s, size_t n, int file)
     for (lex_walk w = lex_walk_start(s, n); lex_walk_next(&w);)
         if (lex_walk_camera(&w, &open, &close)) {
             lex_put(&t, s + copied, w.a - copied);
-            put_camera(&t, s, w.a, open, close > open ? close - 1 : open, index++, w.line, file);
+            copied = w.a;
+            if (s[close - 1] != '}') {
+                /* Unclosed: kept as it is, after a mark that makes the copy differ from the
+                   scene, so that POV-Ray is run and says where the scene is wrong. */
+                lex_puts(&t, "#debug \"\" ");
+                break;
+            }
+            put_camera(&t, s, w.a, open, close - 1, index++, w.line, file);
             lex_walk_past(&w, copied = close);
         }
     lex_put(&t, s + copied, n - copied);
