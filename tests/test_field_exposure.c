@@ -137,6 +137,37 @@ static double field_centre(const camera *c, int *core_count)
     return sum / c->samples.spp;
 }
 
+/* Normalized weights make the film centre's mean weight 1: the scale times the irradiance
+   from the lens alone is 1, with dispersion over the wavelengths as they are sampled. The cone
+   at the centre changes with the index: through a singlet of SF11 behind its stop it holds 2%
+   more light averaged over the spectrum than at the d line, and the Takumar's 0.7%, which the
+   d line's scale left in every picture. */
+Test(field_exposure, normalized_weights_make_the_centre_one_over_the_spectrum)
+{
+    const char *dir = test_tmpdir();
+    const char *singlet = tmp_path(dir, "sf11.dat");
+    write_text(singlet, "# a stop 20 mm before a biconvex SF11 singlet (N-SF11: n_d 1.78472, "
+                        "V_d 25.68)\n0 20 0 4 0\n60 5 1.78472 25 25.68\n-60 0 1 25 0\n");
+    const char *const lenses[] = {singlet, LENS_DIR "takumar.50mm.dat",
+                                  LENS_DIR "cooke-triplet.50mm.dat"};
+    for (int i = 0; i < 3; i++)
+        for (int spectral = 0; spectral < 2; spectral++) {
+            lens l;
+            l2p_error err;
+            cr_assert_eq(lens_read(lenses[i], &l, &err), 0, "%s", err.text);
+            camera_options o;
+            camera_options_default(&o);
+            o.width = 64, o.height = 48;
+            o.dispersion = spectral ? DISPERSION_ON : DISPERSION_OFF;
+            camera c;
+            cr_assert_eq(camera_setup(&c, &l, &o, &err), 0, "%s", err.text);
+            const double centre = c.weight_scale * centre_irradiance_spectral(&c);
+            cr_expect(fabs(centre - 1.0) < 1e-4, "%s%s: the centre's mean weight is %.6f",
+                      lenses[i], spectral ? ", with dispersion" : "", centre);
+            camera_free(&c);
+        }
+}
+
 /* Over eight seeds, field sampling at the film's centre against the lens's own irradiance
    there, at 16 and 64 shared samples, full aperture and f/8, on the four standard lenses and
    one of real glass, at its d line and with dispersion. Without the strata it moved

@@ -170,36 +170,50 @@ static int setup_focus(camera *c, const camera_options *o, l2p_error *err)
     return L2P_OK;
 }
 
-/* The mean weight at the film centre, blocked rays counting 0: the scale that makes it 1 makes
-   the centre as bright as a pinhole camera. The rays from the axial point that get through
-   form a cone (rotational symmetry) of half-angle theta_max, and the mean of A cos^4 / Z^2 over
-   any disk that holds it is then exactly pi sin^2(theta_max), the cone's projected solid angle:
+/* The mean weight at the film centre at wavelength nm, blocked rays counting 0. The rays from
+   the axial point that get through form a cone (rotational symmetry) of half-angle theta_max,
+   and the mean of A cos^4 / Z^2 over any disk that holds it is then exactly pi sin^2(theta_max),
+   the cone's projected solid angle:
    (1/A) int_0^rho (A Z^2 / (Z^2 + r^2)^2) 2 pi r dr = pi rho^2 / (Z^2 + rho^2). The cone's edge
-   is bisected along a radius of the sampled disk (u in [0.5, 1] maps to radius 2u - 1). A grid
-   over the disk converges only like 1/N, and not monotonically (2% off at 48 x 48). */
-static double centre_mean_weight(const camera *c)
+   is bisected along a radius of the disk sampled at nm (u in [0.5, 1] maps to radius 2u - 1).
+   A grid over the disk converges only like 1/N, and not monotonically (2% off at 48 x 48). */
+static double centre_mean_weight_at(const camera *c, double nm)
 {
     const vec3 centre = v3(0, 0, 0);
     ray r;
     double w, in = 0.0, out = 1.0;
-    if (!camera_trace(c, centre, 0.5, 0.5, &r, &w))
+    if (!camera_trace_at(c, centre, 0.5, 0.5, nm, &r, &w))
         return 0.0;
-    if (camera_trace(c, centre, 1.0, 0.5, &r, &w))
+    if (camera_trace_at(c, centre, 1.0, 0.5, nm, &r, &w))
         in = 1.0;
     for (int k = 0; k < 60 && in < 1.0; k++) {
         const double mid = 0.5 * (in + out);
-        if (camera_trace(c, centre, 0.5 + 0.5 * mid, 0.5, &r, &w))
+        if (camera_trace_at(c, centre, 0.5 + 0.5 * mid, 0.5, nm, &r, &w))
             in = mid;
         else
             out = mid;
     }
-    /* the pupil camera_trace draws from, at the d line */
-    const pupil *pu = camera_pupil_at(c, WAVELENGTH_D_NM);
+    const pupil *pu = camera_pupil_at(c, nm);   /* the pupil camera_trace_at draws from */
     pupil_shape disk;
     if (!pupil_shape_at(pu, 0.0, &disk))
         return 0.0;
     const double rho = in * disk.radius_mm[0], z = pu->z_mm;
     return M_PI * rho * rho / (z * z + rho * rho);
+}
+
+/* The mean weight at the film centre: the scale that makes it 1 makes the centre as bright as
+   a pinhole camera. With dispersion the cone changes with the wavelength (the pupil's image
+   moves and grows with the index), and the mean is over the wavelengths as they are sampled,
+   lambda = P^-1(u) for u uniform (spectrum.h), by the midpoint rule in u. */
+static double centre_mean_weight(const camera *c)
+{
+    if (!c->dispersion)
+        return centre_mean_weight_at(c, WAVELENGTH_D_NM);
+    enum { STEPS = 128 };
+    double sum = 0.0;
+    for (int i = 0; i < STEPS; i++)
+        sum += centre_mean_weight_at(c, spectrum_wavelength_nm((i + 0.5) / STEPS));
+    return sum / STEPS;
 }
 
 static int setup_weights(camera *c, weighting w, l2p_error *err)
@@ -242,6 +256,7 @@ static int setup_film(camera *c, const camera_options *o, l2p_error *err)
 
 static int setup_dispersion(camera *c, const camera_options *o, l2p_error *err)
 {
+    c->glass = lens_has_abbe(&c->lens);
     if (!isnan(o->wavelength_nm)) {
         if (o->dispersion == DISPERSION_ON)
             return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "--wavelength traces one wavelength, "
@@ -492,12 +507,18 @@ void camera_trace_batch(const camera *c, sample_batch *s)
 
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight)
 {
+    return camera_trace_at(c, film_point, u, v, WAVELENGTH_D_NM, out, weight);
+}
+
+bool camera_trace_at(const camera *c, vec3 film_point, double u, double v, double nm, ray *out,
+                     double *weight)
+{
     sample_batch s;
     s.n = 1;
     s.film_point[0] = film_point;
     s.u[0] = u;
     s.v[0] = v;
-    s.wavelength_nm[0] = WAVELENGTH_D_NM;
+    s.wavelength_nm[0] = nm;
     camera_trace_batch(c, &s);
     *out = s.out[0];
     *weight = s.weight[0];

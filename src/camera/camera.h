@@ -52,6 +52,7 @@ typedef struct camera {
     trace_kind trace;
     weighting weighting;
     bool dispersion;           /* each sample traced at its own wavelength (spectrum.h) */
+    bool glass;                /* the lens file gives Abbe numbers (before --wavelength) */
     double weight_scale;       /* multiplies A cos^4 / Z^2 (1 when physical) */
     double focus_distance_units;  /* film plane to in-focus plane; INFINITY at infinity */
     double f_number;           /* rear focal length / entrance pupil diameter */
@@ -79,6 +80,9 @@ void camera_free(camera *c);
    success gives the outgoing ray in camera space (origin on the front of the lens) and its
    weight, and returns true; false when the lens blocks it. */
 bool camera_trace(const camera *c, vec3 film_point, double u, double v, ray *out, double *weight);
+/* The same at wavelength nm when the camera has dispersion (the d line's without). */
+bool camera_trace_at(const camera *c, vec3 film_point, double u, double v, double nm, ray *out,
+                     double *weight);
 
 /* Film samples traced together, interleaved for speed: in, each one's film point and pupil
    sample, and its wavelength when the camera has dispersion; out, its ray, its weight and

@@ -528,8 +528,17 @@ void cli_print_options(FILE *out, const char *command)
     }
 }
 
+void cli_warn_wavelength(const cli *c, const char *lens_path, bool glass)
+{
+    if (!isnan(c->cam.wavelength_nm) && !glass)
+        fprintf(stderr, "lens2pov: warning: %s gives no Abbe numbers, so its indices are the same "
+                        "at every wavelength: --wavelength %g changes nothing\n", lens_path,
+                c->cam.wavelength_nm);
+}
+
 void cli_warn(const cli *c, const camera *cam, bool picture)
 {
+    cli_warn_wavelength(c, cam->lens.path, cam->glass);
     /* A film nearer the lens than its focal plane images a virtual object: nothing in front of
        the lens is sharp. */
     if (!isnan(c->cam.film_distance_mm) && !(cam->focus_distance_units > 0.0))

@@ -49,6 +49,8 @@ void cli_print_options(FILE *out, const char *command);
    that puts the focus behind the camera, and for a command that makes a picture (trace and
    render), --pupil stop (biased on purpose) and a stop where diffraction would show. */
 void cli_warn(const cli *c, const camera *cam, bool picture);
+/* Warns that --wavelength changes nothing on a lens without Abbe numbers (glass false). */
+void cli_warn_wavelength(const cli *c, const char *lens_path, bool glass);
 
 /* L2P_BAD_INPUT unless c has exactly `positional` arguments and, when output, a -o. */
 int cli_expect_arguments(const cli *c, int positional, bool output, l2p_error *err);

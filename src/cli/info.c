@@ -83,7 +83,7 @@ static void print_fields(FILE *out, const field *f, int n, bool json)
     }
 }
 
-void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,
+void info_print(FILE *out, const lens *l, bool glass, const lens_info *li, const camera *c,
                 double wavelength_nm, bool json)
 {
     field f[32] = {
@@ -140,13 +140,12 @@ void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,
             fprintf(out, *p == '"' || *p == '\\' ? "\\%c" : (unsigned char)*p < 32 ? "\\u%04x" : "%c", *p);
         fputs("\",\n", out);
         /* Only for files that give Abbe numbers: a four-column file prints as it always did. */
-        if (lens_has_abbe(l))
+        if (glass)
             fputs("  \"abbe_numbers\": true,\n", out);
     }
     else
         fprintf(out, "%s (%d surfaces, stop on line %d%s)\n", l->path, l->count,
-                l->surface[l->stop].line, lens_has_abbe(l) ? ", Abbe numbers given"
-                                          : isnan(wavelength_nm) ? "" : ", one wavelength");
+                l->surface[l->stop].line, glass ? ", Abbe numbers given" : "");
     print_fields(out, f, n, json);
     if (json)
         fprintf(out, "}\n");
@@ -158,6 +157,7 @@ int info_command(const cli *c, l2p_error *err)
     lens l;
     if (st || (st = lens_read_named(c->positional[0], &l, err)))
         return st;
+    const bool glass = lens_has_abbe(&l);
     if (!isnan(c->cam.wavelength_nm))
         lens_at_wavelength(&l, c->cam.wavelength_nm);
     lens_info li;
@@ -175,8 +175,11 @@ int info_command(const cli *c, l2p_error *err)
     }
     if (!st && with_camera)
         cli_warn(c, &cam, false);
+    else if (!st)
+        cli_warn_wavelength(c, l.path, glass);
     if (!st)
-        info_print(stdout, &l, &li, with_camera ? &cam : NULL, c->cam.wavelength_nm, c->json);
+        info_print(stdout, &l, glass, &li, with_camera ? &cam : NULL, c->cam.wavelength_nm,
+                   c->json);
     if (with_camera && !st)
         camera_free(&cam);
     lens_free(&l);

@@ -25,8 +25,8 @@ double info_half_field_deg(const camera *c, vec3 p);
 double info_working_f_number(const camera *c);
 
 /* Prints them, and the camera's focus and field of view when c is not NULL; the wavelength
-   first when it is not NAN (the lens was taken to it). */
-void info_print(FILE *out, const lens *l, const lens_info *li, const camera *c,
+   first when it is not NAN (the lens was taken to it); glass: the file gives Abbe numbers. */
+void info_print(FILE *out, const lens *l, bool glass, const lens_info *li, const camera *c,
                 double wavelength_nm, bool json);
 
 #endif

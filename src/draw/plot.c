@@ -95,7 +95,8 @@ static int write_script(const char *path, const char *what, const char *table, c
     FILE *f = fopen(path, "w");
     if (!f)
         return -1;
-    fprintf(f, "set terminal pngcairo size %d,%d font 'DejaVu Sans,10'\n"
+    /* noenhanced: a lens's name is text, its '_' and '^' no sub- or superscripts */
+    fprintf(f, "set terminal pngcairo noenhanced size %d,%d font 'DejaVu Sans,10'\n"
                "set output 'plot.png'\nset grid\nset key bottom left\nset title '%s'\n"
                "set xlabel 'film radius (mm)'\n", PLOT_WIDTH_PX, PLOT_HEIGHT_PX, title);
     if (!strcmp(what, "distortion")) {
@@ -104,7 +105,8 @@ static int write_script(const char *path, const char *what, const char *table, c
                    "plot '%s' using 1:4 with linespoints lw 2 pt 7 title 'distortion', \\\n"
                    "  '' using 1:2 axes x1y2 with lines dt 2 lw 1 title 'field angle'\n", table);
     } else {
-        fprintf(f, "set ylabel 'relative illumination E(r)/E(0)'\nset yrange [0:1.05]\nplot");
+        /* from 0 to 1.05 at least, further where a lens is brighter off the axis */
+        fprintf(f, "set ylabel 'relative illumination E(r)/E(0)'\nset autoscale yfixmax\nset yrange [0:1.05<*]\nplot");
         for (int i = 0; i < count; i++)
             fprintf(f, "%s '%s' using 1:%d with linespoints lw 2 pt 7 title '%s'", i ? "," : "",
                     i ? "" : table, i + 2, labels[i]);
