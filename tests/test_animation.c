@@ -93,6 +93,103 @@ Test(animation, field_frames_named_as_povray_traced_once)
     frames_match_povray("field", "field.map");
 }
 
+/* The markers of POV-Ray's own pictures PREFIX_OWN<f>.png and the lens's PREFIX_LENS<f>.png
+   (no frame number where f is 0) land on the same pixels. */
+static void markers_match(const char *dir, const char *own_prefix, const char *lens_prefix, int f)
+{
+    char own[64], lens[64];
+    snprintf(own, sizeof own, f ? "%s%d.png" : "%s.png", own_prefix, f);
+    snprintf(lens, sizeof lens, f ? "%s%d.png" : "%s.png", lens_prefix, f);
+    for (int c = 0; c < 3; c++) {
+        const marker_centroid a = image_marker(tmp_path(dir, own), c),
+                              b = image_marker(tmp_path(dir, lens), c);
+        cr_assert(a.found && b.found, "%s marker %d missing (POV-Ray %d, lens %d)", lens, c,
+                  a.found, b.found);
+        cr_expect(fabs(a.x - b.x) < 1.0 && fabs(a.y - b.y) < 1.0,
+                  "%s marker %d: POV-Ray (%.2f, %.2f), lens (%.2f, %.2f)", lens, c, a.x, a.y,
+                  b.x, b.y);
+    }
+}
+
+/* A povray.ini in the scene's folder that sets the clock, or makes an animation, with no
+   options after "--": POV-Ray's own camera and the lens see the same frames, the red marker
+   moving with the clock. Field sampling held the clock at 0 for the scene while taking the
+   camera at the ini's clock, and made one picture of an animation. */
+Test(animation, an_ini_that_sets_the_clock_or_frames_is_followed)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512];
+    const char *scene = hold(scene_buf, dir, "scene.pov");
+    write_text(scene, ANIMATED_SCENE "Marker(<2 * clock - 1, 0.9, 0>, <1, 0, 0>)\n");
+    static const char *const inis[] = {"Clock=0.7\n", "Initial_Frame=1\nFinal_Frame=2\n"};
+    for (int k = 0; k < 2; k++) {
+        write_text(tmp_path(dir, "povray.ini"), inis[k]);
+        char cmd[1024], own[24], lens[24];
+        snprintf(own, sizeof own, "own%d_", k);
+        snprintf(lens, sizeof lens, "lens%d_", k);
+        snprintf(cmd, sizeof cmd, "cd '%s' && povray +Iscene.pov +O%s.png +W48 +H36 +FN -A -D "
+                 "-V -GA >povray.log 2>&1", dir, own);
+        cr_assert_eq(system_povray(cmd), 0, "%s", cmd);
+        char out[600];
+        snprintf(out, sizeof out, "%s/%s.png", dir, lens);
+        char *errtext = NULL;
+        const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--angle", "scene",
+                           "--jobs", "2", "-q", "-o", out);
+        cr_assert_eq(st, 0, "%s: %s", inis[k], errtext ? errtext : "");
+        free(errtext);
+        for (int f = k; f <= 2 * k; f++)
+            markers_match(dir, own, lens, f);
+    }
+}
+
+/* A dolly (the camera moving toward its look-at point) changes the focus, and each frame is
+   traced again; with --focus-distance the focus is the same for every frame, and one table
+   serves them all. */
+Test(animation, a_fixed_focus_traces_a_dolly_once)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512], keep_buf[512];
+    const char *scene = hold(scene_buf, dir, "dolly.pov");
+    write_text(scene, "#version 3.7;\nsphere { 0, 0.5 pigment { rgb 1 } }\n"
+                      "camera { location <0, 0, -4 + clock> look_at 0 angle 30 }\n");
+    static const char *const focus[][2] = {{"--seed", "0"}, {"--focus-distance", "3"}};
+    for (int k = 0; k < 2; k++) {
+        char keep_name[16];
+        snprintf(keep_name, sizeof keep_name, "keep%d", k);
+        const char *keep = hold(keep_buf, dir, keep_name);
+        char *errtext = NULL;
+        const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--sampling", "pixel",
+                           focus[k][0], focus[k][1], "-q", "--keep-temp", keep, "-o",
+                           tmp_path(dir, "d.png"), "--", "+KFI1", "+KFF3");
+        cr_assert_eq(st, 0, "%s", errtext ? errtext : "");
+        free(errtext);
+        const int maps = (file_exists(tmp_path(keep, "rays.map")) ? 1 : 0) +
+                         (file_exists(tmp_path(keep, "rays.t1.map")) ? 1 : 0) +
+                         (file_exists(tmp_path(keep, "rays.t2.map")) ? 1 : 0);
+        cr_expect_eq(maps, k ? 1 : 3, "%s: %d tables", focus[k][0], maps);
+    }
+}
+
+/* A frame the lens cannot see is refused when its table is set up, after the frames before
+   it: the message names the frame, and says where an angle came from. */
+Test(animation, a_frame_the_lens_cannot_see_is_named)
+{
+    const char *dir = test_tmpdir();
+    char scene_buf[512];
+    const char *scene = hold(scene_buf, dir, "zoom.pov");
+    write_text(scene, "#version 3.7;\nsphere { 0, 0.5 pigment { rgb 1 } }\n"
+                      "camera { location <0, 0, -4> look_at 0 angle 20 + 60 * clock }\n");
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, SIZE, "--sampling", "pixel",
+                       "--angle", "scene", "-q", "-o", tmp_path(dir, "z.png"), "--", "+KFI1",
+                       "+KFF2");
+    cr_expect_eq(st, 2);
+    cr_expect(errtext && strstr(errtext, "lens2pov: frame 2: ") &&
+              strstr(errtext, "the scene camera's angle 80"), "%s", errtext ? errtext : "");
+    free(errtext);
+    cr_expect(file_exists(tmp_path(dir, "z1.png")), "frame 1 was not kept");
+}
+
 /* Without --keep-temp a field animation's renders go from the work folder once their frame is
    developed. Four samples of a 48x36 film make one render a frame at --jobs 1, so a POV-Ray run
    (a stand-in that counts the pictures under TMPDIR, then runs POV-Ray) sees at most the

@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -712,6 +714,45 @@ Test(image_io, failed_write_leaves_nothing)
     cr_assert(strstr(err.text, path), "%s", err.text);
     cr_assert_eq(count_entries(dir, NULL, NULL, 0), 1);
     rmdir(path);
+}
+
+/* A write cut short (here by a file size limit, as a full disk cuts it) fails in every format
+   and leaves the earlier picture as it was, with no temporary file. OpenImageIO's PNG writer
+   reports nothing then: the file's end is checked. */
+Test(image_io, a_write_cut_short_keeps_the_earlier_picture)
+{
+    const char *dir = test_tmpdir();
+    enum { W = 96, H = 64 };
+    static float rgb[3 * W * H];
+    uint32_t x = 1;
+    for (int i = 0; i < 3 * W * H; i++) {   /* noise: tens of kilobytes in any format */
+        x = x * 1664525u + 1013904223u;
+        rgb[i] = (float)(x >> 8) * 0x1.0p-24f;
+    }
+    const char *const names[] = {"cut.png", "cut.exr", "cut.tif"};
+    signal(SIGXFSZ, SIG_IGN);   /* the write fails with EFBIG instead of killing the test */
+    for (int k = 0; k < 3; k++) {
+        const char *path = tmp_path(dir, names[k]);
+        l2p_error err = {0, ""};
+        float one[3] = {0.5f, 0.5f, 0.5f};
+        cr_assert_eq(image_write_rgb(path, 1, 1, one, NULL, 0, &err), L2P_OK, "%s", err.text);
+        size_t before_size;
+        char *before = read_text(path, &before_size);
+        struct rlimit old, limit;
+        cr_assert_eq(getrlimit(RLIMIT_FSIZE, &old), 0);
+        limit = old;
+        limit.rlim_cur = 4096;
+        cr_assert_eq(setrlimit(RLIMIT_FSIZE, &limit), 0);
+        const int st = image_write_rgb(path, W, H, rgb, NULL, 0, &err);
+        cr_assert_eq(setrlimit(RLIMIT_FSIZE, &old), 0);
+        cr_expect_eq(st, L2P_FAILED, "%s: %s", names[k], err.text);
+        size_t after_size;
+        char *after = read_text(path, &after_size);
+        cr_expect(after_size == before_size && !memcmp(before, after, before_size),
+                  "%s was replaced", names[k]);
+        cr_expect_eq(count_entries(dir, ".", NULL, 0), 0, "a temporary file was left");
+        free(before), free(after);
+    }
 }
 
 Test(image_io, atomic_write_leaves_no_temp)

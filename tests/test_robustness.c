@@ -56,8 +56,8 @@ static int unexpected_files(const char *dir, const char *const *allowed, const c
 /* ---------------------------------------------------------------- invalid options */
 
 /* One bad command line: words after "lens2pov" (OUT is replaced by a prefix in a fresh
-   folder, OUTEXR by an image path there, SCENE by a scene there), and words the message must
-   contain. */
+   folder, OUTEXR by an image path there, SCENE by a scene there, DIR by the folder itself),
+   and words the message must contain. */
 typedef struct bad_line {
     const char *words[16];
     const char *expect;
@@ -179,6 +179,10 @@ static const bad_line BAD_OPTIONS[] = {
     {{"trace", DGAUSS, "--spp", "--quiet", "-o", "OUT"}, "--spp needs a value, not the option"},
     {{"diagram", DGAUSS, "-o", ".svg"}, "no file name before .svg"},
     {{"--version", "extra"}, "--version takes nothing"},
+    /* the scene a folder; a kept folder made for a run refused before any work is not left */
+    {{"render", "DIR", DGAUSS, "-o", "OUTEXR"}, "is a folder, not a scene file"},
+    {{"render", "SCENE", DGAUSS, "--f-number", "1", "--keep-temp", "OUT", "-o", "OUTEXR"},
+     "--f-number"},
 };
 
 /* The parameters of a test a row: row numbers, in Criterion's shared memory (a test's process
@@ -221,6 +225,7 @@ ParameterizedTest(size_t *row, robustness, bad_command_lines_are_refused)
                : !strcmp(x, "OUTEXR")      ? outexr
                : !strncmp(x, "OUT.", 4)    ? named[k]
                : !strcmp(x, "SCENE")       ? scene
+               : !strcmp(x, "DIR")         ? (char *)dir
                                            : (char *)x;
         strncat(line, x, sizeof line - strlen(line) - 2);
         strcat(line, " ");

@@ -438,3 +438,32 @@ Test(scene_camera, other_cameras_are_left_to_povray)
         free(log);
     }
 }
+
+/* A povray.ini that turns POV-Ray's console off (All_Console=Off, as -GA does) silenced the
+   probe, and the lens took POV-Ray's default camera, with exit 0: lens2pov's own options turn
+   the console on again after the user's. */
+Test(scene_camera, an_ini_that_turns_the_console_off_still_gives_the_camera)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "povray.ini"), "All_Console=Off\n");
+    expect_markers_in(dir, MARKERS_HEAD CAMERA("x"), NULL);
+}
+
+/* A camera in a file whose #include names it by an expression is not seen (only names
+   written as strings are followed): the default camera is taken, and a warning names the
+   line. */
+Test(scene_camera, an_include_of_a_computed_name_is_warned_of)
+{
+    const char *dir = test_tmpdir();
+    write_text(tmp_path(dir, "cam.inc"), "camera { location <0, 1, -4> look_at 0 }\n");
+    const char *scene = tmp_path(dir, "computed.pov");
+    write_text(scene, "#version 3.7;\nbackground { rgb 1 }\n#declare Name = \"cam.inc\";\n"
+                      "#include Name\n");
+    char *errtext = NULL;
+    const int st = L2P(NULL, &errtext, "render", scene, DGAUSS, "--width", "16", "--height", "12",
+                       "--spp", "1", "-q", "-o", tmp_path(dir, "c.png"));
+    cr_expect_eq(st, 0, "%s", errtext ? errtext : "");
+    cr_expect(errtext && strstr(errtext, "computed.pov:4: this #include names its file by an "
+                                         "expression"), "%s", errtext ? errtext : "");
+    free(errtext);
+}

@@ -51,9 +51,13 @@ static bool close_to(double a, double b)
     return a == b || fabs(a - b) <= SAME_FOCUS * fmax(fabs(a), fabs(b));
 }
 
+/* The look-at point's distance focuses the lens only when --focus-distance and
+   --film-distance are not given (the same for every frame). */
 static bool same_table(const cli *a, const cli *b)
 {
-    return close_to(a->cam.look_at.z, b->cam.look_at.z) && a->cam.mirror == b->cam.mirror &&
+    const bool focus_given = !isnan(a->cam.focus_distance_units) || !isnan(a->cam.film_distance_mm);
+    return (focus_given || close_to(a->cam.look_at.z, b->cam.look_at.z)) &&
+           a->cam.mirror == b->cam.mirror &&
            (!a->angle_scene || close_to(a->angle_deg, b->angle_deg));
 }
 
@@ -113,12 +117,16 @@ int render_frames_plan(const cli *c, render_frames *out, l2p_error *err)
     out->digits = povargs_frame_digits(sf.final_frame);
     out->tables = sf.animated ? 0 : 1;
     bool perturbed = false;
+    int unseen = 0;
     for (int i = 0; !st && i < sf.count; i++, out->count++) {
         st = plan_frame(out, i, c, &sf, err);
         perturbed = perturbed || sf.frame[i].cam.perturbed;
+        unseen = unseen ? unseen : sf.frame[i].cam.computed_include;
     }
-    if (!st)
+    if (!st) {
         framing_warn_perturbed(c->positional[0], perturbed && !c->placed);
+        framing_warn_unseen(c->positional[0], c->placed ? 0 : unseen);
+    }
     scene_frames_free(&sf);
     return st;
 }

@@ -16,8 +16,18 @@ int framing_from_scene(cli *c, const char *scene, l2p_error *err)
     if (!st) {
         framing_apply(c, &sc);
         framing_warn_perturbed(scene, sc.perturbed && !c->placed);
+        framing_warn_unseen(scene, sc.computed_include);
     }
     return st;
+}
+
+void framing_warn_unseen(const char *scene, int line)
+{
+    if (line)
+        fprintf(stderr, "lens2pov: warning: %s:%d: this #include names its file by an expression, "
+                "in which lens2pov cannot see a camera statement: POV-Ray's default camera is "
+                "taken (if the file holds the camera, give --location, --look-at and --angle)\n",
+                scene, line);
 }
 
 void framing_warn_perturbed(const char *scene, bool perturbed)
@@ -95,8 +105,9 @@ static int solve_film(camera *cam, const lens *l, const cli *c, l2p_error *err)
     double half_width = NAN;
     if (!(most >= half_deg))
         st = l2p_fail(err, L2P_BAD_INPUT, l->path, 0,
-                      "--angle %g: this lens sees at most %.4g degrees across (at its focus "
-                      "in effect)", c->angle_deg, 2.0 * most);
+                      "%s %g: this lens sees at most %.4g degrees across (at its focus in "
+                      "effect)", c->angle_scene ? "the scene camera's angle" : "--angle",
+                      c->angle_deg, 2.0 * most);
     else
         half_width = half_width_for(&f, half_deg, x);
     field_angles_close(&f);

@@ -16,6 +16,9 @@ int framing_from_scene(cli *c, const char *scene, l2p_error *err);
 
 /* The warning for a scene camera with a normal { } (perturbed), which the lens leaves out. */
 void framing_warn_perturbed(const char *scene, bool perturbed);
+/* Warns that the scene's camera was taken for POV-Ray's default one while an #include of a
+   computed name (at line, 0: none) may hold a camera statement lens2pov cannot see. */
+void framing_warn_unseen(const char *scene, int line);
 
 /* The same from a scene camera already read (one frame of an animation). */
 void framing_apply(cli *c, const scene_camera *sc);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "base/cleanup.h"
 #include "base/cores.h"
@@ -18,6 +19,7 @@
 #include "base/outfile.h"
 #include "povray/povargs.h"
 #include "povray/povray.h"
+#include "povray/scenecam.h"
 #include "raytable/chunk_name.h"
 #include "base/tempdir.h"
 #include "cli/sizecheck.h"
@@ -54,7 +56,11 @@ static int check_inputs(const cli *c, l2p_error *err)
     FILE *f = fopen(c->positional[0], "r");
     if (!f)
         return l2p_fail(err, L2P_BAD_INPUT, c->positional[0], 0, "cannot read: %s", strerror(errno));
+    struct stat sb;
+    const bool folder = fstat(fileno(f), &sb) == 0 && S_ISDIR(sb.st_mode);
     fclose(f);
+    if (folder)
+        return l2p_fail(err, L2P_BAD_INPUT, c->positional[0], 0, "is a folder, not a scene file");
     int st = povargs_check(c->povray_args, c->povray_arg_count, err);
     if (st)
         return st;
@@ -407,6 +413,19 @@ static int field_and_render(const cli *c, const camera *cam, const workspace *ws
     return !st && with_csv ? outfile_commit(csv, err) : st;
 }
 
+/* A table of an animation that cannot be set up says for which frames: the frames before it
+   are rendered by then. */
+static void name_frames(l2p_error *err, const table_frames *tf)
+{
+    char prefix[96];
+    const int n = snprintf(prefix, sizeof prefix, "frame %d%s: ", tf->frame[0]->number,
+                           tf->count > 1 ? " and those it shares a table with" : "");
+    const size_t keep = strnlen(err->text, sizeof err->text - 1 - (size_t)n);
+    memmove(err->text + n, err->text, keep);
+    err->text[n + keep] = '\0';
+    memcpy(err->text, prefix, (size_t)n);
+}
+
 /* Table t: its camera, then its frames. */
 static int render_table(const render_frames *rf, int t, const workspace *ws, int jobs,
                         outfile *csv, l2p_error *err)
@@ -428,6 +447,8 @@ static int render_table(const render_frames *rf, int t, const workspace *ws, int
                 cli_warn(c, &cam, true);
             st = c->field_sampling ? field_and_render(c, &cam, ws, jobs, csv, &tf, t, err)
                                    : trace_and_render(c, &cam, ws, jobs, csv, &tf, t, err);
+        } else if (rf->animated) {
+            name_frames(err, &tf);
         }
         camera_free(&cam);   /* also after a failed setup, as it always was */
     }
@@ -466,8 +487,19 @@ int render_command(const cli *given, l2p_error *err)
     if (given->povray_args && !args)
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     resolved.povray_args = args;
+    /* An ini may make POV-Ray animate or move the clock without options: the render then
+       takes the path of POV-Ray's options (frames as POV-Ray numbers them, a run a render, no
+       animation loop of lens2pov's, which holds the clock at 0), "+V", which lens2pov gives
+       anyway, standing for them. */
+    static char *const ini_settings[] = {"+V"};
+    if (!given->povray_args && scene_inis_set_frames(given->positional[0])) {
+        resolved.povray_args = ini_settings;
+        resolved.povray_arg_count = 1;
+    }
     render_frames rf;
-    if ((st = render_frames_plan(c, &rf, err)) || (st = check_frames(c, &rf, err))) {
+    if ((st = render_frames_plan(c, &rf, err)) || (st = check_frames(c, &rf, err)) ||
+        (st = size_check_frames(c, c->keep_temp ? c->keep_temp : temp_root(), jobs, rf.count,
+                                rf.tables, err))) {
         render_frames_free(&rf);
         povargs_free(args);
         return st;

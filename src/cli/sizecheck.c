@@ -282,20 +282,36 @@ int size_check_trace(const cli *c, l2p_error *err)
     return check_disk(c, needs, 2, err);
 }
 
-int size_check_render(const cli *c, const char *work_dir, int jobs, l2p_error *err)
+/* frames pictures, each from one table's renders; a kept folder (--keep-temp) keeps the
+   tables and every frame's renders, else one of each is there at a time. */
+static int check_render(const cli *c, const char *work_dir, int jobs, int frames, int tables,
+                        l2p_error *err)
 {
     if (c->no_size_check)
         return L2P_OK;
     const size_estimate e = size_estimate_of(c, jobs);
+    const bool kept = c->keep_temp != NULL;
     /* Pixel sampling writes the CSV in the workspace, then moves (or copies) it to --rays. */
     const double csv_work = e.csv_in_workspace ? e.csv_bytes : 0.0;
-    const disk_need needs[] = {{work_dir, true, e.table_bytes + e.renders_bytes + csv_work},
+    const double work = e.table_bytes * (kept ? tables : 1) + e.renders_bytes * (kept ? frames : 1);
+    const disk_need needs[] = {{work_dir, true, work + csv_work},
                                {c->rays_csv ? c->rays_csv : c->output, false, e.csv_bytes},
-                               {c->output, false, crop_pixels(&c->cam) * 16.0}};
+                               {c->output, false, crop_pixels(&c->cam) * 16.0 * frames}};
     int st = check_disk(c, needs, 3, err);
     const double have = available_memory();
     if (!st && have > 0.0 && e.memory_bytes > have)
         st = refuse(c, "memory (POV-Ray's processes at once, or developing)", e.memory_bytes,
                     have, NULL, err);
     return st;
+}
+
+int size_check_render(const cli *c, const char *work_dir, int jobs, l2p_error *err)
+{
+    return check_render(c, work_dir, jobs, 1, 1, err);
+}
+
+int size_check_frames(const cli *c, const char *work_dir, int jobs, int frames, int tables,
+                      l2p_error *err)
+{
+    return frames > 1 ? check_render(c, work_dir, jobs, frames, tables, err) : L2P_OK;
 }

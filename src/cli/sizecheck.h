@@ -64,4 +64,9 @@ int size_check_trace(const cli *c, l2p_error *err);
    development after them) fit in the memory available. */
 int size_check_render(const cli *c, const char *work_dir, int jobs, l2p_error *err);
 
+/* The same once an animation's frames are known: a picture a frame, and with --keep-temp
+   every table and every frame's renders kept. */
+int size_check_frames(const cli *c, const char *work_dir, int jobs, int frames, int tables,
+                      l2p_error *err);
+
 #endif

@@ -62,7 +62,8 @@ int workspace_make(workspace *w, const char *keep, l2p_error *err)
     w->lock_fd = -1;
     if (w->keep) {
         snprintf(w->dir, sizeof w->dir, "%s", keep);
-        if (mkdir(w->dir, 0777) != 0 && errno != EEXIST)
+        w->made = mkdir(w->dir, 0777) == 0;
+        if (!w->made && errno != EEXIST)
             return l2p_fail(err, L2P_BAD_INPUT, w->dir, 0, "cannot make folder: %s", strerror(errno));
         return lock_kept(w, err);
     }
@@ -81,6 +82,8 @@ void workspace_remove(const workspace *w)
     if (w->keep) {
         if (w->lock_fd >= 0)
             close(w->lock_fd);   /* the lock goes with it */
+        if (w->made)
+            rmdir(w->dir);   /* made for a run refused before it wrote anything: not left empty */
         return;
     }
     DIR *d = opendir(w->dir);

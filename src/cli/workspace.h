@@ -9,6 +9,7 @@
 typedef struct workspace {
     char dir[4096];
     bool keep;                 /* --keep-temp's folder: left in place */
+    bool made;                 /* kept, and made by this render (removed when left empty) */
     int lock_fd;               /* the kept folder, locked while this render uses it; else -1 */
 } workspace;
 
@@ -18,7 +19,7 @@ typedef struct workspace {
 int workspace_make(workspace *w, const char *keep, l2p_error *err);
 
 /* Removes the workspace and its files (nothing in it has folders), unless it is kept; a kept
-   one is unlocked. */
+   one is unlocked, and removed when this render made it and left it empty. */
 void workspace_remove(const workspace *w);
 
 #endif

@@ -25,6 +25,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <fcntl.h>
 #include <new>
 #include <string>
 #include <sys/stat.h>
@@ -322,6 +323,32 @@ bool write_pixels(ImageOutput &out, file_kind kind, const float *pixels, size_t 
     return out.write_image(TypeDesc::FLOAT, pixels);   // OIIO rounds to half
 }
 
+// The file under temp on the disk (fsync), and a PNG ending in its IEND chunk: OpenImageIO's
+// PNG writer reports no failed write, and a full disk or a file size limit left a truncated
+// picture that replaced a good one with exit 0. (Reading it back through libpng would say so
+// too, but prints libpng's own error on stderr.)
+int check_written(const std::string &temp, const char *path, file_kind kind, l2p_error *err)
+{
+    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+    const int fd = open(temp.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0 || fsync(fd) != 0) {
+        const int e = errno;
+        if (fd >= 0)
+            close(fd);
+        return fail(err, L2P_FAILED, path, std::string("cannot write: ") + std::strerror(e));
+    }
+    unsigned char tail[12];
+    struct stat st;
+    const bool whole = kind != file_kind::PNG ||
+                       (fstat(fd, &st) == 0 && st.st_size >= 12 &&
+                        pread(fd, tail, sizeof tail, st.st_size - 12) == (ssize_t)sizeof tail &&
+                        std::memcmp(tail, iend, sizeof tail) == 0);
+    close(fd);
+    return whole ? L2P_OK
+                 : fail(err, L2P_FAILED, path, "cannot write: the picture written is incomplete "
+                                               "(is the disk full?)");
+}
+
 // Writes the complete file under temp; the caller renames it.
 int write_temp(const std::string &temp, const char *path, file_kind kind, const ImageSpec &spec,
                const float *pixels, l2p_error *err)
@@ -334,7 +361,7 @@ int write_temp(const std::string &temp, const char *path, file_kind kind, const 
         const std::string message = out->geterror();
         return fail(err, L2P_FAILED, path, "cannot write: " + message);
     }
-    return L2P_OK;
+    return check_written(temp, path, kind, err);
 }
 
 int write_rgb(const char *path, int width, int height, const float *pixels,

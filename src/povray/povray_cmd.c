@@ -129,7 +129,8 @@ int povray_write_sequence_wrapper(const char *path, const char *scene,
 /* The command line. POV-Ray's own options from the user come first, so that everything after
    them overrides what they (or an .ini they name) set: the chunk's ini (its size), then no
    display, no pause, no continuing an old render, no alpha (it zeroes the background), no
-   antialiasing (it mixes neighbouring rays), +V for the progress lines, -GS -GR for no
+   antialiasing (it mixes neighbouring rays), +GA for POV-Ray's messages (a user's -GA or
+   All_Console=Off would hide its errors), +V for the progress lines, -GS -GR for no
    statistics, EXR, and Display_Gamma=sRGB, which sets how a scene without gamma handling
    is decoded into the linear EXR. An animation frame is rendered alone as a subset (+SF,
    +EF) of the user's animation, so that the scene sees POV-Ray's own clock, frame_number
@@ -151,7 +152,7 @@ char **povray_argv(const povray_cmd *cmd, const povray_chunk *c, const povray_op
     argv[n++] = str_printf("+I\"%s\"", cmd->wrapper);
     argv[n++] = str_printf("+O\"%s\"", cmd->output);
     argv[n++] = str_printf("+L\"%s\"", cmd->scene_dir);
-    const char *fixed[] = {"-D", "-P", "-C", "-UA", "-A", "+V", "-GS", "-GR", "+FE",
+    const char *fixed[] = {"-D", "-P", "-C", "-UA", "-A", "+GA", "+V", "-GS", "-GR", "+FE",
                            "Display_Gamma=sRGB"};
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
         argv[n++] = strdup(fixed[i]);

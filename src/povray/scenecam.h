@@ -22,6 +22,8 @@ typedef struct scene_camera {
     bool found;                /* false: no camera statement ran, POV-Ray's default camera */
     int line;                  /* the statement's line in its file (0 when not found) */
     bool perturbed;            /* it has a normal { }, which the lens leaves out */
+    int computed_include;      /* not found: the line of an #include of a computed name in
+                                  the scene, whose camera statement would not be seen; 0 */
 } scene_camera;
 
 /* Runs POV-Ray on a copy of the scene at width x height (image_width and image_height read so)
@@ -51,6 +53,11 @@ typedef struct scene_frames {
 int scene_frames_read(const char *scene_path, int width, int height, char *const *args,
                       int arg_count, scene_frames *out, l2p_error *err);
 void scene_frames_free(scene_frames *f);
+
+/* Whether an ini POV-Ray reads before the scene (POVINI, a povray.ini in the scene's folder,
+   the user's, the system's) names frames, the clock, the language version or another ini:
+   then POV-Ray may render the scene as an animation, or at another clock, without options. */
+bool scene_inis_set_frames(const char *scene_path);
 
 /* The files the probe's messages name: path[0] the scene, path[k] the k-th included file
    whose copy prints its camera statements (scene_copy_make). */
@@ -107,5 +114,9 @@ void scene_text_includes(const char *text, size_t n, scene_include_visit visit, 
 /* Whether text has a camera statement scene_camera_rewrite would replace; *line gets the
    first one's line. */
 bool scene_text_has_camera(const char *text, size_t n, int *line);
+
+/* The line of the first #include whose file is named by an expression, not a string (0 for
+   none): lens2pov cannot see a camera statement in that file. */
+int scene_text_computed_include(const char *text, size_t n);
 
 #endif

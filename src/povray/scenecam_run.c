@@ -46,6 +46,22 @@ static bool plain_path(const char *p)
     return true;
 }
 
+static char *folder_of(const char *path)
+{
+    char *abs = NULL;
+    if (path[0] == '/') {
+        abs = strdup(path);
+    } else {
+        char cwd[4096];
+        if (getcwd(cwd, sizeof cwd) && (abs = malloc(strlen(cwd) + strlen(path) + 2)))
+            sprintf(abs, "%s/%s", cwd, path);
+    }
+    char *slash = abs ? strrchr(abs, '/') : NULL;
+    if (slash)
+        slash[slash == abs ? 1 : 0] = '\0';
+    return abs;
+}
+
 /* POV-Ray parses the copy in the scene's folder, as the render will run it: the same
    povray.ini, the same includes. One pixel is traced; the parse is what counts. */
 typedef struct probe_args {
@@ -89,6 +105,20 @@ static bool settings_may_differ(const char *dir)
         if (ini[i] && access(ini[i], F_OK) == 0)
             return true;
     return ini_sets_frames_or_version(ini[POVARGS_INIS - 1]);
+}
+
+bool scene_inis_set_frames(const char *scene)
+{
+    char *dir = folder_of(scene);
+    char buf[POVARGS_INIS][POVARGS_INI_PATH];
+    const char *ini[POVARGS_INIS];
+    bool found = false;
+    if (dir)
+        povargs_default_inis(dir, buf, ini);
+    for (int i = 0; dir && !found && i < POVARGS_INIS; i++)
+        found = ini[i] && ini_sets_frames_or_version(ini[i]);
+    free(dir);
+    return found;
 }
 
 /* The marks of a probe that has done its work, in the order it prints them: the frame line
@@ -164,8 +194,10 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     char end_rows[64], end_cols[64];
     snprintf(end_rows, sizeof end_rows, "+ER%d", h > 1 ? 2 : 1);
     snprintf(end_cols, sizeof end_cols, "+EC%d", w > 1 ? 2 : 1);
+    /* +GA first: a user's -GA (or All_Console=Off) silences every stream, and a later +GD
+       alone does not bring the debug stream back */
     char *own[] = {in, size_w, size_h, rows, end_rows, cols, end_cols, "-F", "-D",
-                   "-P", "-C", "-A", "-GS", "-GR", "+GD"};
+                   "-P", "-C", "-A", "+GA", "-GS", "-GR", "+GD"};
     enum { OWN = sizeof own / sizeof own[0] };
     char **argv = calloc((size_t)pa->user_count + OWN + 2, sizeof *argv);
     if (!argv)
@@ -223,21 +255,6 @@ static int run_probe(const char *dir, const char *copy, const char *log, int w, 
     return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? L2P_OK : -1;
 }
 
-static char *folder_of(const char *path)
-{
-    char *abs = NULL;
-    if (path[0] == '/') {
-        abs = strdup(path);
-    } else {
-        char cwd[4096];
-        if (getcwd(cwd, sizeof cwd) && (abs = malloc(strlen(cwd) + strlen(path) + 2)))
-            sprintf(abs, "%s/%s", cwd, path);
-    }
-    char *slash = abs ? strrchr(abs, '/') : NULL;
-    if (slash)
-        slash[slash == abs ? 1 : 0] = '\0';
-    return abs;
-}
 
 /* POV-Ray's options after "--" that POV-Ray itself refused ("Problem with option setting",
    without naming the option): the message names them all. */
@@ -411,6 +428,10 @@ static int probe(const char *scene, const char *dir, const char *work, int w, in
             st = run_copy(scene, dir, work, w, h, pa, &sc, out, err);
         free(literal);
     }
+    const int computed = st ? 0 : scene_text_computed_include(text, n);
+    for (int i = 0; computed && i < out->count; i++)
+        if (!out->frame[i].cam.found)
+            out->frame[i].cam.computed_include = computed;
     scene_copy_free(&sc);
     free(text);
     return st;

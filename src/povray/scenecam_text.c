@@ -281,6 +281,15 @@ void scene_text_includes(const char *s, size_t n, scene_include_visit visit, voi
             return;
 }
 
+int scene_text_computed_include(const char *s, size_t n)
+{
+    for (lex_walk w = lex_walk_start(s, n); lex_walk_next(&w);)
+        if (s[w.a] != '"' && lex_is_word(s, w.prev_a, w.prev_b, "include") &&
+            w.prev2_b == w.prev2_a + 1 && s[w.prev2_a] == '#')
+            return w.line;
+    return 0;
+}
+
 bool scene_text_has_camera(const char *s, size_t n, int *line)
 {
     char *copy = scene_camera_rewrite(s, n);
