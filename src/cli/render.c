@@ -209,6 +209,33 @@ static povray_chunk *chunk_list(const writer *w, int count, long long faces,
     return pc;
 }
 
+/* The workspace's CSV onto the temporary name beside --rays (opened at the start, so that a
+   bad path fails at once): renamed, or copied when on another file system, and closed, so
+   that a write that fails (a full disk) does so before any picture is replaced. */
+static int stage_csv(const char *from, outfile *out, l2p_error *err)
+{
+    if (rename(from, out->temp_path) != 0) {
+        if (errno != EXDEV)
+            return l2p_fail(err, L2P_FAILED, out->final_path, 0, "cannot write: %s",
+                            strerror(errno));
+        FILE *in = fopen(from, "rb");
+        if (!in)
+            return l2p_fail(err, L2P_FAILED, from, 0, "cannot read: %s", strerror(errno));
+        char buf[1 << 16];
+        int st = L2P_OK;
+        for (size_t n; !st && (n = fread(buf, 1, sizeof buf, in)) > 0;)
+            if (fwrite(buf, 1, n, out->fp) != n)
+                st = l2p_fail(err, L2P_FAILED, out->final_path, 0, "write failed: %s",
+                              strerror(errno));
+        if (!st && ferror(in))
+            st = l2p_fail(err, L2P_FAILED, from, 0, "read failed");
+        fclose(in);
+        if (st)
+            return st;
+    }
+    return outfile_finish(out, err);
+}
+
 /* The frames, each developed through the writer's sample map as soon as its chunks'
    pictures are in (povray_options' picture_done, on the calling thread) once the writer is
    done, since the map is complete only then: an animation stopped midway keeps the frames it
@@ -224,6 +251,8 @@ typedef struct frames_developing {
     bool *developed;
     const char **exrs;         /* a frame's pictures, one a chunk */
     bool remove_pictures;      /* a frame's pictures are deleted once it is developed */
+    outfile *csv;              /* --rays, staged before the first picture is written; NULL */
+    bool csv_staged;
 } frames_developing;
 
 static int develop_frame(frames_developing *d, int f, int chunks, l2p_error *err)
@@ -237,6 +266,8 @@ static int develop_frame(frames_developing *d, int f, int chunks, l2p_error *err
     }
     for (int i = 0; !st && i < chunks; i++)
         d->exrs[i] = d->pc[i * d->tf->count + f].output_exr;
+    if (!st && d->csv && !d->csv_staged)
+        d->csv_staged = !(st = stage_csv(d->w->csv, d->csv, err));
     if (!st)
         st = develop_files(&d->map, d->exrs, chunks, d->tf->frame[f]->output, err);
     for (int i = 0; !st && d->remove_pictures && i < chunks; i++)
@@ -270,33 +301,6 @@ static int develop_rest(frames_developing *d, l2p_error *err)
     return st;
 }
 
-/* The workspace's CSV into the user's (opened at the start, so that a bad path fails at
-   once): renamed onto its temporary name, or copied when on another file system; then
-   committed. */
-static int publish_csv(const char *from, outfile *out, l2p_error *err)
-{
-    if (rename(from, out->temp_path) != 0) {
-        if (errno != EXDEV)
-            return l2p_fail(err, L2P_FAILED, out->final_path, 0, "cannot write: %s",
-                            strerror(errno));
-        FILE *in = fopen(from, "rb");
-        if (!in)
-            return l2p_fail(err, L2P_FAILED, from, 0, "cannot read: %s", strerror(errno));
-        char buf[1 << 16];
-        int st = L2P_OK;
-        for (size_t n; !st && (n = fread(buf, 1, sizeof buf, in)) > 0;)
-            if (fwrite(buf, 1, n, out->fp) != n)
-                st = l2p_fail(err, L2P_FAILED, out->final_path, 0, "write failed");
-        if (!st && ferror(in))
-            st = l2p_fail(err, L2P_FAILED, from, 0, "read failed");
-        fclose(in);
-        if (st)
-            return st;
-    }
-    return outfile_commit(out, err);
-}
-
-
 /* Writes one table and renders its chunks for each of its frames side by side, developing
    each frame as it comes in. */
 static int trace_and_render(const cli *c, const camera *cam, const workspace *ws, int jobs,
@@ -317,7 +321,8 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
     const int chunk_jobs = (jobs + tf->count - 1) / tf->count;
     w.chunk_faces = chunk_faces_for(cam, c, chunk_jobs, &count);
     povray_chunk *pc = chunk_list(&w, count, w.chunk_faces, tf);
-    frames_developing d = {.w = &w, .pc = pc, .tf = tf, .remove_pictures = !ws->keep};
+    frames_developing d = {.w = &w, .pc = pc, .tf = tf, .remove_pictures = !ws->keep,
+                           .csv = c->rays_csv && table == 0 ? csv : NULL};
     d.done = calloc((size_t)tf->count, sizeof *d.done);
     d.developed = calloc((size_t)tf->count, sizeof *d.developed);
     d.exrs = calloc((size_t)count + 1, sizeof *d.exrs);
@@ -352,8 +357,10 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
             st = image_io_ready(err);
         if (!st)
             st = develop_rest(&d, err);
-        if (!st && c->rays_csv && table == 0)
-            st = publish_csv(w.csv, csv, err);
+        if (!st && d.csv && !d.csv_staged)
+            st = stage_csv(w.csv, csv, err);
+        if (!st && d.csv)
+            st = outfile_commit(csv, err);
     }
     pthread_mutex_destroy(&w.lock);
     if (d.have_map)

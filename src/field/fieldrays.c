@@ -4,7 +4,9 @@
    are packed into renders. */
 #include "field/fieldrays.h"
 
+#include <errno.h>
 #include <stdlib.h>
+#include <string.h>
 #include "field/fieldpixels.h"
 #include "field/fieldtiles.h"
 #include "field/strata.h"
@@ -72,5 +74,6 @@ int field_rays_write(FILE *out, const char *path, const camera *c, int strata_sa
         put_subimage(out, piece, &t, tiles, &p, &at[k], b);
     }
     free(b), free(piece);
-    return ferror(out) ? l2p_fail(err, L2P_FAILED, path, 0, "write failed") : L2P_OK;
+    return ferror(out) ? l2p_fail(err, L2P_FAILED, path, 0, "write failed: %s", strerror(errno))
+                       : L2P_OK;
 }
