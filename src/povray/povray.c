@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/prctl.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -167,6 +168,21 @@ static void log_hint(const run *r, const job *j, char *out, size_t n)
         snprintf(out, n, "its log is empty; --keep-temp DIR keeps the logs");
 }
 
+/* POV-Ray says a full disk only as a file it could not write ("Cannot access data in file",
+   a halted render): when the work folder's file system has less than a mebibyte left, the
+   message says so. */
+static int with_full_disk(const run *r, int st, l2p_error *err)
+{
+    struct statvfs v;
+    if (st && statvfs(r->opts->work_dir, &v) == 0 &&
+        (double)v.f_bavail * (double)v.f_frsize < 1048576.0) {
+        const size_t n = strlen(err->text);
+        snprintf(err->text + n, sizeof err->text - n, " (the file system of %s is full)",
+                 r->opts->work_dir);
+    }
+    return st;
+}
+
 /* Why a job failed, in POV-Ray's own words when its log has them (a sequence's: those of the
    frame it failed in). */
 static int explain_failure(const run *r, job *j, int status, l2p_error *err)
@@ -196,7 +212,7 @@ static int explain_failure(const run *r, job *j, int status, l2p_error *err)
 static int check_finished(run *r, job *j, int status, l2p_error *err)
 {
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        return explain_failure(r, j, status, err);
+        return with_full_disk(r, explain_failure(r, j, status, err), err);
     int st = L2P_OK;
     for (int i = 0; i < task_chunks(r, j->task) && !st; i++) {
         const int k = task_first(r, j->task) + i;
@@ -209,7 +225,8 @@ static int check_finished(run *r, job *j, int status, l2p_error *err)
         else if (access(written, R_OK) != 0) {
             char hint[256];
             log_hint(r, j, hint, sizeof hint);
-            st = l2p_fail(err, L2P_FAILED, written, 0, "POV-Ray finished without writing it (%s)", hint);
+            st = with_full_disk(r, l2p_fail(err, L2P_FAILED, written, 0, "POV-Ray finished "
+                                            "without writing it (%s)", hint), err);
         } else {
             st = povray_picture_finished(r, k, written, err);
         }
