@@ -755,6 +755,24 @@ Test(image_io, a_write_cut_short_keeps_the_earlier_picture)
     }
 }
 
+/* An EXR keeps its values: half floats when they hold them, else 32-bit floats, so that
+   physical weights through a tiny stop (1e-8) and bright ones (1e6) are not lost. */
+Test(image_io, an_exr_keeps_values_half_floats_cannot)
+{
+    const char *path = tmp_path(test_tmpdir(), "range.exr");
+    const float rgb[6] = {6.517e-8f, 1e-5f, 0.25f, 1e6f, 3.0f, 0.0f};
+    l2p_error err = {0, ""};
+    cr_assert_eq(image_write_rgb(path, 2, 1, rgb, NULL, 0, &err), L2P_OK, "%s", err.text);
+    int w, h;
+    float *px;
+    cr_assert_eq(image_read_rgba(path, &w, &h, &px, &err), L2P_OK, "%s", err.text);
+    for (int i = 0; i < 2; i++)
+        for (int c = 0; c < 3; c++)
+            cr_expect_eq(px[4 * i + c], rgb[3 * i + c], "pixel %d channel %d: %g, written %g", i,
+                         c, px[4 * i + c], rgb[3 * i + c]);
+    free(px);
+}
+
 Test(image_io, atomic_write_leaves_no_temp)
 {
     const char *dir = test_tmpdir();

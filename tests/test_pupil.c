@@ -347,16 +347,19 @@ Test(pupil, irradiance_matches_an_independent_integral_over_the_lens)
 
 /* With --trace thick the light comes through the exit pupil, the stop's image, and nothing else
    stops it: the mean weight of the thick camera's samples is the disk's projected solid angle
-   (irradiance_through_disk, which plot --what vignetting --trace thick draws). */
+   (irradiance_through_disk, which plot --what vignetting --trace thick draws), whichever pupil
+   samples it. The rear pupil's larger disk passed everything it sampled, as if at full
+   opening: at f/8 the double-Gauss's centre came out 17 times too bright. */
 Test(pupil, thick_irradiance_is_the_exit_pupils_disk)
 {
     const double f_numbers[] = {NAN, 8.0};
     for (int li = 0; li < 2; li++)
-        for (int fi = 0; fi < 2; fi++) {
+        for (int fi = 0; fi < 4; fi++) {
             camera_options o;
             camera_options_default(&o);
-            o.width = 64, o.height = 48, o.focus_distance_units = 10.0, o.f_number = f_numbers[fi];
+            o.width = 64, o.height = 48, o.focus_distance_units = 10.0, o.f_number = f_numbers[fi % 2];
             o.weighting = WEIGHTING_PHYSICAL, o.trace = TRACE_KIND_THICK;
+            o.pupil = fi < 2 ? PUPIL_STOP_IMAGE : PUPIL_REAR;
             camera c;
             test_camera(&c, LENSES[li], &o);
             double z, radius;
@@ -367,8 +370,9 @@ Test(pupil, thick_irradiance_is_the_exit_pupils_disk)
                 double se;
                 const double got = estimate(&c, p, SIDE, &se);
                 const double want = irradiance_through_disk(v3_length(p), z, radius);
-                cr_assert(fabs(got - want) <= 4.0 * se + 1e-4 * want, "%s f/%g, film (%.2f, %.2f): "
-                          "%.6g, the disk %.6g", LENSES[li], f_numbers[fi], p.x, p.y, got, want);
+                cr_assert(fabs(got - want) <= 4.0 * se + 1e-4 * want, "%s f/%g, %s pupil, film "
+                          "(%.2f, %.2f): %.6g, the disk %.6g", LENSES[li], f_numbers[fi % 2],
+                          pupil_kind_name(o.pupil), p.x, p.y, got, want);
             }
             camera_free(&c);
         }

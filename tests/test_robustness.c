@@ -850,20 +850,32 @@ Test(robustness, an_output_naming_an_input_is_refused)
 }
 
 /* A stop so small that diffraction would blur every point over more than 1% of the film's
-   diagonal is traced, with a warning naming the Airy disk: 2.44 x 550 nm x 10000 = 13.4 mm on
-   the double-Gauss at f/10000; at f/64 (0.086 mm, 0.25% of 35 mm) nothing is said. */
+   diagonal is traced, with a warning naming the Airy disk at the working f-number: on the
+   double-Gauss at f/10000, focused at 1 m, 2.44 x 550 nm x 10520 = 14.1 mm (a magnification
+   of 1/19 adds 5% to the f-number); at f/64 (0.09 mm, 0.26% of 35 mm) nothing is said. The
+   macro at 0.4 m and f/200 works at f/331 (its cone traced by an independent tracer):
+   0.444 mm, more than 1% of 35 mm, where the f-number alone gave 0.27 mm. */
 Test(robustness, a_stop_too_small_for_ray_optics_is_warned_of)
 {
     const char *dir = test_tmpdir();
     char *errtext = NULL;
     cr_assert_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "8", "--height", "6", "--spp", "1",
                               "--f-number", "10000", "-o", tmp_path(dir, "a"), "--quiet", NULL), 0);
-    cr_expect(strstr(errtext, "warning: at f/1e+04 diffraction") && strstr(errtext, "13.4 mm"), "%s", errtext);
+    cr_expect(strstr(errtext, "warning: at working f/1.052e+04 diffraction") &&
+              strstr(errtext, "14.1 mm"), "%s", errtext);
     free(errtext);
     errtext = NULL;
     cr_assert_eq(run_lens2pov(NULL, &errtext, "trace", DGAUSS, "--width", "8", "--height", "6", "--spp", "1",
                               "--f-number", "64", "-o", tmp_path(dir, "b"), "--quiet", NULL), 0);
     cr_expect(!strstr(errtext, "diffraction"), "%s", errtext);
+    free(errtext);
+    errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "trace", LENS_DIR "macro.105mm.dat", "--width", "8",
+                              "--height", "6", "--spp", "1", "--f-number", "200",
+                              "--focus-distance", "0.4", "-o", tmp_path(dir, "c"), "--quiet",
+                              NULL), 0);
+    cr_expect(strstr(errtext, "warning: at working f/330.6 diffraction") &&
+              strstr(errtext, "0.444 mm"), "%s", errtext);
     free(errtext);
 }
 

@@ -220,9 +220,10 @@ static int setup_weights(camera *c, weighting w, l2p_error *err)
 {
     c->weighting = w;
     c->weight_scale = 1.0;
+    const double mean = centre_mean_weight(c);
+    c->centre_cone_sin2 = mean > 0.0 ? mean / M_PI : 0.0;
     if (w == WEIGHTING_PHYSICAL)
         return L2P_OK;
-    const double mean = centre_mean_weight(c);
     if (!(mean > 0.0))
         return l2p_fail(err, L2P_BAD_INPUT, c->lens.path, c->lens.surface[c->lens.stop].line,
                         "with this stop, the lens blocks every ray at the film centre: nothing "
@@ -400,8 +401,12 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
         st = setup_focus(c, o, err);
     if (!st)
         st = thick_lens_of(&c->lens, 0, c->lens.count - 1, &c->thick, err);
+    /* A thick lens has no rear element: its rear pupil is the stop's image too, the one
+       aperture a thick lens has (trace_thick), seen whole from every film point. */
+    const pupil_kind kind =
+        o->trace == TRACE_KIND_THICK && o->pupil == PUPIL_REAR ? PUPIL_STOP_IMAGE : o->pupil;
     if (!st)
-        st = pupil_make(&c->lens, o->pupil, &c->pupil, err);
+        st = pupil_make(&c->lens, kind, &c->pupil, err);
     /* The stop pupil stays the seed's diagnostic, and thick tracing samples the stop's image,
        as the seed's third variant does: a thick lens blocks nothing. */
     if (!st && o->pupil != PUPIL_STOP && o->trace == TRACE_KIND_FULL) {
@@ -414,6 +419,8 @@ int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
         st = pupil_stop_image(&c->lens, false, &z, &r, err);
         c->f_number = thick_efl_mm(&c->thick) / (2.0 * r);
     }
+    if (!st && c->trace == TRACE_KIND_THICK)
+        st = pupil_stop_image(&c->lens, true, &c->thick_exit_z_mm, &c->thick_exit_radius_mm, err);
     if (!st)
         st = setup_weights(c, o->weighting, err);
     /* The blades last: a polygon inscribed in the opening passes a subset of the round stop's
@@ -440,10 +447,17 @@ void camera_free(camera *c)
    the front vertex, so both kinds of trace see the same scene in front of the lens. */
 static bool trace_thick(const camera *c, ray *r)
 {
+    /* The thick lens's one aperture is the stop's image: a ray it would not pass is blocked
+       whatever pupil sampled it (the rear pupil's disk is larger, the stop's elsewhere). The
+       stop-image pupil samples that disk itself; 1e-9 keeps its rim. */
+    const double t = (c->thick_exit_z_mm - r->o.z) / r->d.z;
+    const vec3 at = v3_madd(r->o, r->d, t);
+    if (!(r->d.z > 0.0) || !(hypot(at.x, at.y) <= c->thick_exit_radius_mm * (1.0 + 1e-9)))
+        return false;
     if (!thick_trace_toward_scene(&c->thick, r))
         return false;
-    const double t = (c->lens.surface[0].vertex_z_mm - r->o.z) / r->d.z;
-    r->o = v3_madd(r->o, r->d, t);
+    const double to_front = (c->lens.surface[0].vertex_z_mm - r->o.z) / r->d.z;
+    r->o = v3_madd(r->o, r->d, to_front);
     return v3_isfinite(r->o);
 }
 

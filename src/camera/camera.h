@@ -49,6 +49,8 @@ typedef struct camera {
        the spectrum, each covering its neighbours' (camera_pupil_at); else NULL. */
     pupil *spectral;
     thick_lens thick;          /* thick lens of the whole lens (for --trace thick and info) */
+    double thick_exit_z_mm, thick_exit_radius_mm;   /* --trace thick: the exit pupil, which
+                                                       blocks what it does not pass */
     trace_kind trace;
     weighting weighting;
     bool dispersion;           /* each sample traced at its own wavelength (spectrum.h) */
@@ -56,6 +58,9 @@ typedef struct camera {
     double weight_scale;       /* multiplies A cos^4 / Z^2 (1 when physical) */
     double focus_distance_units;  /* film plane to in-focus plane; INFINITY at infinity */
     double f_number;           /* rear focal length / entrance pupil diameter */
+    /* sin^2 of the half-angle of the cone that passes at the film centre (averaged over the
+       spectrum with dispersion), 0 when none: the working f-number is 1 / (2 sin) */
+    double centre_cone_sin2;
     sample_pattern samples;
     int crop_x0, crop_y0, crop_x1, crop_y1;
     /* world_from_camera: p -> location + (p.x right + p.y up + p.z forward) / unit_mm */

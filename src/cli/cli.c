@@ -547,20 +547,25 @@ void cli_warn(const cli *c, const camera *cam, bool picture)
                 -cam->focus_distance_units);
     if (!picture)
         return;
-    if (c->cam.pupil == PUPIL_STOP && c->cam.trace == TRACE_KIND_FULL)
+    if (c->cam.pupil == PUPIL_STOP)
         fprintf(stderr, "lens2pov: warning: --pupil stop aims at the stop's own disk, which misses "
                         "rays the lens passes and holds rays it blocks: the picture is biased (with "
                         "normalized weights the lens's vignetting is lost, too bright off the axis; "
                         "with physical ones too dark; a diagnostic: stop-image and rear are "
                         "unbiased)\n");
     /* Rays leave out diffraction: through a stop this small it would blur every point over the
-       Airy disk, 2.44 lambda N across (lambda 550 nm), more than 1% of the film's diagonal. */
-    const double airy_mm = 2.44 * 550e-6 * cam->f_number;
+       Airy disk, 2.44 lambda N_w across (lambda 550 nm; N_w = 1 / (2 sin theta), the working
+       f-number of the cone that reaches the film centre, larger than N when focused near),
+       more than 1% of the film's diagonal. */
+    const double n_w = cam->centre_cone_sin2 > 0.0 ? 0.5 / sqrt(cam->centre_cone_sin2)
+                                                   : cam->f_number;
+    const double airy_mm = 2.44 * 550e-6 * n_w;
     if (airy_mm > 0.01 * cam->film.diagonal_mm)
-        fprintf(stderr, "lens2pov: warning: at f/%.4g diffraction, which ray tracing leaves out, would "
-                        "blur every point over %.3g mm (the Airy disk, 2.44 lambda N at 550 nm), "
-                        "%.0f pixels: the picture is not what this lens would take\n", cam->f_number,
-                airy_mm, airy_mm / (cam->film.width_mm / cam->film.width));
+        fprintf(stderr, "lens2pov: warning: at working f/%.4g diffraction, which ray tracing "
+                        "leaves out, would blur every point over %.3g mm (the Airy disk, 2.44 "
+                        "lambda N at 550 nm), %.3g pixels: the picture is not what this lens "
+                        "would take\n", n_w, airy_mm,
+                airy_mm / (cam->film.width_mm / cam->film.width));
 }
 
 int cli_expect_arguments(const cli *c, int positional, bool output, l2p_error *err)

@@ -371,12 +371,16 @@ static int trace_and_render(const cli *c, const camera *cam, const workspace *ws
 }
 
 /* Whether --adaptive can take this still (fieldtiles.h): its first round needs 4 samples at
-   least, and dispersion deals its wavelength bands over all spp samples, which a tile's first
-   samples would not cover evenly. Else a note, and the still is rendered uniformly. */
+   least, dispersion deals its wavelength bands over all spp samples, which a tile's first
+   samples would not cover evenly, and blades post-stratify all spp samples (strata.c). Else
+   a note, and the still is rendered uniformly. */
 static bool adaptive_fits(const cli *c, const camera *cam)
 {
-    const char *why = cam->samples.spp < 16 ? "it needs --spp 16 or more"
-                      : cam->dispersion    ? "the lens has dispersion" : NULL;
+    const char *why = cam->samples.spp < 16   ? "it needs --spp 16 or more"
+                      : cam->dispersion      ? "the lens has dispersion"
+                      : cam->lens.blades.count ? "the stop has blades, whose exposure needs "
+                                                 "all the samples at once"
+                                             : NULL;
     if (why && !c->quiet)
         fprintf(stderr, "lens2pov: note: rendering every pixel with %d samples, since "
                         "--adaptive cannot take this picture (%s)\n", cam->samples.spp, why);

@@ -153,7 +153,9 @@ static void post_count(const camera *c, int n, sample_batch *b, field_strata *ou
     out->axis_share = mean_over_spectrum(share, c);
     out->axis_count = passing;
     out->camera = c;
-    out->post = passing > 0 && passing < n && out->axis_share > 0.0 && out->axis_share < 1.0;
+    /* K = N: every sample carries a (the others' stratum is empty, its light on the axis
+       none). K = 0 leaves nothing to carry the axis's light: the plain weights then. */
+    out->post = passing > 0 && out->axis_share > 0.0 && out->axis_share < 1.0;
 }
 
 /* The core's share: c^2 averaged over the wavelengths' sampling density, lambda = P^-1(u) for
@@ -241,7 +243,8 @@ double field_strata_place(const field_strata *t, film_sample *s)
         sample_batch b;   /* one sample: on the stack, no failure to handle */
         const int n = t->camera->samples.spp, k = t->axis_count;
         return passes_on_axis(t->camera, *s, &b) ? n * t->axis_share / k
-                                                 : n * (1.0 - t->axis_share) / (n - k);
+               : k < n                           ? n * (1.0 - t->axis_share) / (n - k)
+                                                 : 1.0;   /* none such, but a ray's doubt */
     }
     if (!t->on)
         return 1.0;

@@ -291,11 +291,24 @@ void add_attributes(ImageSpec &spec, const image_attribute *attributes, int coun
         spec.attribute("ImageDescription", description);
 }
 
-ImageSpec make_spec(file_kind kind, int width, int height)
+// Whether half floats keep every value to their 11 bits: none nonzero below the smallest
+// normal half, 2^-14 (physical weights through a tiny stop give 1e-8), nor above the largest.
+bool fits_half(const float *pixels, size_t count)
+{
+    for (size_t i = 0; i < count; i++) {
+        const float a = std::fabs(pixels[i]);
+        if (a != 0.0f && (a < 0x1.0p-14f || a > 65504.0f))
+            return false;
+    }
+    return true;
+}
+
+ImageSpec make_spec(file_kind kind, int width, int height, bool half)
 {
     const TypeDesc type = kind == file_kind::PNG    ? TypeDesc::UINT8
                           : kind == file_kind::TIFF ? TypeDesc::UINT16
-                                                    : TypeDesc::HALF;
+                          : half                    ? TypeDesc::HALF
+                                                    : TypeDesc::FLOAT;
     ImageSpec spec(width, height, 3, type);
     spec.attribute("oiio:ColorSpace", kind == file_kind::EXR ? "Linear" : "sRGB");
     if (kind != file_kind::PNG)
@@ -320,7 +333,7 @@ bool write_pixels(ImageOutput &out, file_kind kind, const float *pixels, size_t 
     if (kind == file_kind::TIFF)
         return out.write_image(TypeDesc::UINT16,
                                encode_srgb<uint16_t>(pixels, count, 65535.0f).data());
-    return out.write_image(TypeDesc::FLOAT, pixels);   // OIIO rounds to half
+    return out.write_image(TypeDesc::FLOAT, pixels);   // OIIO rounds to half where asked
 }
 
 // The file under temp on the disk (fsync), and a PNG ending in its IEND chunk: OpenImageIO's
@@ -383,7 +396,8 @@ int write_rgb(const char *path, int width, int height, const float *pixels,
     int st = check_folder(target, err);
     if (st)
         return st;
-    ImageSpec spec = make_spec(kind, width, height);
+    ImageSpec spec = make_spec(kind, width, height,
+                               fits_half(pixels, (size_t)width * (size_t)height * 3));
     add_attributes(spec, attributes, attribute_count);
     std::string temp;
     if ((st = make_temp(target, ext, temp, err)))

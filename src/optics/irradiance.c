@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include "optics/chief.h"
 #include "optics/trace_batch.h"
 
 /* The coarse grid's cells on a side: a cell of 2/128 in direction cosines is a quarter of the
@@ -49,14 +50,40 @@ static long count_passing(const lens *l, vec3 p, const grid *g, double *box)
     return count;
 }
 
+/* A set narrower than the coarse grid's cells (a small stop: at f/50 the cone's half-angle is
+   1/100) can fall between their centres. It lies about the chief ray, the ray through the
+   stop's centre: grids of 16 x 16 cells centred on its direction cosines, a quarter as wide
+   each time, until one finds it; *h gets its cell. */
+static long find_about_chief(const lens *l, vec3 p, double *box, double *h)
+{
+    chief_lens c;
+    if (chief_lens_open(&c, l))
+        return 0;
+    const double r = hypot(p.x, p.y);
+    double slope;
+    long count = 0;
+    if (chief_slope(&c, r, &slope)) {
+        const double along = slope / sqrt(1.0 + slope * slope);
+        const double a = r > 0.0 ? along * p.x / r : 0.0, b = r > 0.0 ? along * p.y / r : 0.0;
+        for (double width = 8.0 * 2.0 / COARSE_CELLS; !count && width > 1e-12; width *= 0.25) {
+            const grid g = {a - 0.5 * width, b - 0.5 * width, width / 16, 16};
+            count = count_passing(l, p, &g, box);
+            *h = g.h;
+        }
+    }
+    chief_lens_close(&c);
+    return count;
+}
+
 double irradiance_at(const lens *l, vec3 p, int n)
 {
     double box[4] = {1, -1, 1, -1};
     const grid coarse = {-1.0, -1.0, 2.0 / COARSE_CELLS, COARSE_CELLS};
-    if (count_passing(l, p, &coarse, box) == 0)
+    double h = coarse.h;
+    if (count_passing(l, p, &coarse, box) == 0 && find_about_chief(l, p, box, &h) == 0)
         return 0.0;
-    const double side = fmax(box[1] - box[0], box[3] - box[2]) + 5.0 * coarse.h;
-    const grid fine = {box[0] - 2.5 * coarse.h, box[2] - 2.5 * coarse.h, side / n, n};
+    const double side = fmax(box[1] - box[0], box[3] - box[2]) + 5.0 * h;
+    const grid fine = {box[0] - 2.5 * h, box[2] - 2.5 * h, side / n, n};
     double unused[4] = {1, -1, 1, -1};
     return (double)count_passing(l, p, &fine, unused) * fine.h * fine.h;
 }

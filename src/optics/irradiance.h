@@ -9,8 +9,9 @@
 /* E at film point p for a background of radiance 1: the integral of cos(theta) over the
    directions the lens passes from p, which is the area of the passing set in the plane of
    direction cosines (a, b), since d(omega) cos(theta) = da db. A 128 x 128 grid over the unit
-   square finds the set; an n x n grid over its bounding box (grown by two coarse cells)
-   measures it. 0 when no direction passes. */
+   square finds the set (or, when it is narrower than the grid's cells, finer grids about the
+   chief ray's direction); an n x n grid over its bounding box (grown by two cells of the grid
+   that found it) measures it. 0 when no direction passes. */
 double irradiance_at(const lens *l, vec3 p, int n);
 
 /* E for a background of radiance 1 at a film point r from the axis, seen through a disk of
