@@ -115,13 +115,15 @@ Test(field_render, adaptive_refuses_what_it_cannot_render)
                      tmp_path(dir, "t.inc")), 2);
     cr_expect(errtext && strstr(errtext, "trace does not take --adaptive"), "%s", errtext ? errtext : "");
     free(errtext);
-    static const struct { const char *lens, *spp, *why; } uniform[] = {
-        {LENS_DIR "dgauss.50mm.dat", "8", "it needs --spp 16 or more"},
-        {LENS_DIR "takumar.50mm.dat", "16", "the lens has dispersion"}};
-    for (int i = 0; i < 2; i++) {
+    static const struct { const char *lens, *spp, *blades, *why; } uniform[] = {
+        {LENS_DIR "dgauss.50mm.dat", "8", "0", "it needs --spp 16 or more"},
+        {LENS_DIR "takumar.50mm.dat", "16", "0", "the lens has dispersion"},
+        {LENS_DIR "dgauss.50mm.dat", "16", "6", "the stop has blades"}};
+    for (int i = 0; i < 3; i++) {
         errtext = NULL;
         const int st = L2P(NULL, &errtext, "render", scene, uniform[i].lens, "--width", "16",
-                           "--height", "12", "--spp", uniform[i].spp, "--adaptive", "-o", out);
+                           "--height", "12", "--spp", uniform[i].spp, "--aperture-blades",
+                           uniform[i].blades, "--adaptive", "-o", out);
         cr_expect_eq(st, 0, "%s: status %d: %s", uniform[i].lens, st, errtext ? errtext : "");
         cr_expect(errtext && strstr(errtext, uniform[i].why), "%s", errtext ? errtext : "");
         cr_expect(file_exists(out));

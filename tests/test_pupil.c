@@ -499,6 +499,13 @@ Test(pupil, the_stop_pupil_says_its_pictures_are_biased)
     cr_assert_eq(st, 0, "%s", errtext);
     cr_assert(strstr(errtext, "warning: --pupil stop") != NULL, "%s", errtext);
     free(errtext);
+    /* thick tracing's exit pupil is not the stop's disk either */
+    st = run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--width", "4",
+                      "--height", "3", "--spp", "1", "--pupil", "stop", "--trace", "thick", "-o",
+                      tmp_path(dir, "t"), "--quiet", NULL);
+    cr_assert_eq(st, 0, "%s", errtext);
+    cr_expect(strstr(errtext, "warning: --pupil stop") != NULL, "%s", errtext);
+    free(errtext);
     /* info, the diagram and the plot make no picture: their figures do not use the pupil */
     st = run_lens2pov(NULL, &errtext, "info", LENS_DIR "dgauss.50mm.dat", "--pupil", "stop", NULL);
     cr_assert_eq(st, 0, "%s", errtext);

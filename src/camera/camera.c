@@ -94,7 +94,7 @@ static int setup_aperture(lens *l, const camera_options *o, double efl_mm, l2p_e
         char widest[32];
         snprintf(widest, sizeof widest, "%.4g", efl_mm / (full * magnification));
         if (o->f_number < strtod(widest, NULL))
-            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
+            return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[l->stop].line,
                             "--f-number %g is faster than the lens: its widest is f/%s",
                             o->f_number, widest);
         diameter = fmin(full, efl_mm / (o->f_number * magnification));

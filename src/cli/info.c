@@ -108,6 +108,9 @@ void info_print(FILE *out, const lens *l, bool glass, const lens_info *li, const
             {"focus_distance", "focus distance (film to subject)", "units", c->focus_distance_units},
             {"aperture_f_number", "f-number (this aperture)", "", c->f_number},
             {"working_f_number", "working f-number (paraxial)", "", info_working_f_number(c)},
+            /* 1 / (2 sin theta') of the cone that passes at the film centre, rims and all */
+            {"working_f_number_traced", "working f-number (traced)", "",
+             c->centre_cone_sin2 > 0.0 ? 0.5 / sqrt(c->centre_cone_sin2) : NAN},
             {"aperture_diameter_mm", "aperture diameter", "mm", c->lens.stop_diameter_mm},
             {"film_width_mm", "film width", "mm", fi->width_mm},
             {"film_height_mm", "film height", "mm", fi->height_mm},
