@@ -61,9 +61,8 @@ int plot_distortion_table(FILE *out, const camera *c, l2p_error *err)
    thick its exit pupil, the stop's image, which is all a thick lens stops. */
 static double irradiance_of(const camera *c, double r)
 {
-    double z, radius;
-    if (c->trace == TRACE_KIND_THICK && pupil_stop_image(&c->lens, true, &z, &radius, NULL) == L2P_OK)
-        return irradiance_through_disk(r, z, radius);
+    if (c->trace == TRACE_KIND_THICK)
+        return irradiance_through_disk(r, c->thick_exit_z_mm, c->thick_exit_radius_mm);
     return irradiance_at(&c->lens, v3(0, r, 0), PLOT_IRRADIANCE_GRID);
 }
 
