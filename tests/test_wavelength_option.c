@@ -18,6 +18,13 @@ Test(wavelength_option, info_keeps_saying_the_file_gives_abbe_numbers)
     cr_expect(strstr(out, "\"abbe_numbers\": true") && strstr(out, "\"wavelength_nm\": 450"),
               "%s", out);
     free(out), free(errtext);
+    /* with camera options too (the camera's lens, at 450 nm, has no Abbe numbers left) */
+    cr_assert_eq(run_lens2pov(&out, &errtext, "info", LENS_DIR "cooke-triplet.50mm.dat",
+                              "--wavelength", "450", "--focus-distance", "inf", NULL), 0, "%s",
+                 errtext);
+    cr_expect(strstr(out, "Abbe numbers given"), "%s", out);
+    cr_expect_str_empty(errtext);
+    free(out), free(errtext);
 }
 
 Test(wavelength_option, a_lens_without_abbe_numbers_is_warned_of)

@@ -309,9 +309,9 @@ static int fit_at(pupil *p, const lens *l, double nm, double reach_mm, l2p_error
     return st;
 }
 
-static double spectral_nm(int i)
+static double spectral_nm(int i, int count)
 {
-    return SPECTRUM_MIN_NM + i * (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) / (CAMERA_SPECTRAL_PUPILS - 1);
+    return SPECTRUM_MIN_NM + i * (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) / (count - 1);
 }
 
 /* The ratio of the area of pupil b's region to that of a's (the same pupil after and before
@@ -333,15 +333,46 @@ static double grown_area(const pupil *a, const pupil *b)
 
 /* Spectral pupils are fitted when covering the spectrum grows the region more than this: a
    sample then passes less than two times in three as often as with a region for its own
-   wavelength, and the fits (half a second) are worth it. */
+   wavelength. */
 #define SPECTRAL_WORTH 1.5
+
+/* Fits count spectral pupils, each at its wavelength in the plane of c->pupil and covered at
+   its neighbours'; *growth is the most any grew in the covering (grown_area). */
+static int fit_spectral(camera *c, int count, double *growth, l2p_error *err)
+{
+    pupil *own = malloc(sizeof *own);
+    free(c->spectral);
+    c->spectral_count = count;
+    if (!own || !(c->spectral = malloc(sizeof *c->spectral * (size_t)count))) {
+        free(own);
+        return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    }
+    int st = L2P_OK;
+    *growth = 1.0;
+    for (int i = 0; i < count && !st; i++) {
+        pupil *p = &c->spectral[i];
+        *p = c->pupil;
+        st = fit_at(p, &c->lens, spectral_nm(i, count), 0.5 * c->film.diagonal_mm, err);
+        *own = *p;
+        if (!st && i > 0)
+            st = cover_at(p, &c->lens, spectral_nm(i - 1, count), err);
+        if (!st && i + 1 < count)
+            st = cover_at(p, &c->lens, spectral_nm(i + 1, count), err);
+        if (!st)
+            *growth = fmax(*growth, grown_area(own, p));
+    }
+    free(own);
+    return st;
+}
 
 /* With dispersion the pupil fitted at the d line also covers the two ends of the spectrum
    (between them the passing regions move little and smoothly: pupil_cover); it bounds the
-   film's reach. Samples are drawn from spectral pupils instead: each fitted at its wavelength,
-   in the same plane, and covered at its neighbours'. Through a small stop the passing region
-   moves with the wavelength by more than its own size, so one region for the whole spectrum
-   passed a fifth of the samples a region for one wavelength passes. */
+   film's reach. Samples are drawn from spectral pupils instead, when that grows the region
+   much: through a small stop the passing region moves with the wavelength by more than its
+   own size, and one region for the whole spectrum passes a small share of the samples. Their
+   count starts at CAMERA_SPECTRAL_PUPILS; where covering its neighbours still grows a region
+   too much, the neighbours are brought nearer, once: the growth in width is about in
+   proportion to their spacing. */
 static int cover_spectrum(camera *c, l2p_error *err)
 {
     pupil *d_line = malloc(sizeof *d_line);
@@ -353,29 +384,26 @@ static int cover_spectrum(camera *c, l2p_error *err)
         st = cover_at(&c->pupil, &c->lens, SPECTRUM_MAX_NM, err);
     const bool worth = !st && grown_area(d_line, &c->pupil) > SPECTRAL_WORTH;
     free(d_line);
-    if (!worth)
+    double growth;
+    if (!worth || (st = fit_spectral(c, CAMERA_SPECTRAL_PUPILS, &growth, err)) ||
+        !(growth > SPECTRAL_WORTH))
         return st;
-    if (!(c->spectral = malloc(sizeof *c->spectral * CAMERA_SPECTRAL_PUPILS)))
-        st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
-    for (int i = 0; i < CAMERA_SPECTRAL_PUPILS && !st; i++) {
-        pupil *p = &c->spectral[i];
-        *p = c->pupil;
-        st = fit_at(p, &c->lens, spectral_nm(i), 0.5 * c->film.diagonal_mm, err);
-        if (!st && i > 0)
-            st = cover_at(p, &c->lens, spectral_nm(i - 1), err);
-        if (!st && i + 1 < CAMERA_SPECTRAL_PUPILS)
-            st = cover_at(p, &c->lens, spectral_nm(i + 1), err);
-    }
-    return st;
+    const double spacing = (sqrt(SPECTRAL_WORTH) - 1.0) / (sqrt(growth) - 1.0);
+    int count = CAMERA_SPECTRAL_PUPILS;
+    while (count < CAMERA_SPECTRAL_PUPILS_MAX &&
+           (double)(CAMERA_SPECTRAL_PUPILS - 1) / (count - 1) > spacing)
+        count = 2 * count - 1;
+    return fit_spectral(c, count, &growth, err);
 }
 
 const pupil *camera_pupil_at(const camera *c, double nm)
 {
     if (!c->spectral)
         return &c->pupil;
-    const double t = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * (CAMERA_SPECTRAL_PUPILS - 1);
+    const int last = c->spectral_count - 1;
+    const double t = (nm - SPECTRUM_MIN_NM) / (SPECTRUM_MAX_NM - SPECTRUM_MIN_NM) * last;
     /* nearest, clamped before the conversion (NaN takes the first) */
-    return &c->spectral[t > 0.0 ? (int)(fmin(t, CAMERA_SPECTRAL_PUPILS - 1) + 0.5) : 0];
+    return &c->spectral[t > 0.0 ? (int)(fmin(t, last) + 0.5) : 0];
 }
 
 int camera_setup(camera *c, lens *l, const camera_options *o, l2p_error *err)
@@ -537,4 +565,34 @@ bool camera_trace_at(const camera *c, vec3 film_point, double u, double v, doubl
     *out = s.out[0];
     *weight = s.weight[0];
     return s.passed[0];
+}
+
+double camera_pass_share(const camera *c)
+{
+    enum { ACROSS = 16, SPP = 64 };   /* film points a side; samples at each */
+    sample_pattern pattern;
+    sample_pattern_init(&pattern, SPP, 0x9e3779b97f4a7c15u);
+    long long reached = 0, passed = 0;
+    sample_batch b;
+    b.n = 0;
+    for (int i = 0; i < ACROSS * ACROSS * SPP; i++) {
+        const int fx = i % ACROSS, fy = i / ACROSS % ACROSS, k = i / (ACROSS * ACROSS);
+        const double rx = c->crop_x0 + (fx + 0.5) / ACROSS * (c->crop_x1 - c->crop_x0);
+        const double ry = c->crop_y0 + (fy + 0.5) / ACROSS * (c->crop_y1 - c->crop_y0);
+        const sample_pixel pixel = sample_pattern_pixel(&pattern, fx, fy);
+        const film_sample f = sample_pattern_sample(&pattern, pixel, k);
+        b.film_point[b.n] = film_camera_from_raster(&c->film, rx, ry);
+        b.u[b.n] = f.pupil_u;
+        b.v[b.n] = f.pupil_v;
+        b.wavelength_nm[b.n] = sample_pattern_wavelength(&pattern, pixel, k).nm;
+        if (++b.n == CAMERA_BATCH || i + 1 == ACROSS * ACROSS * SPP) {
+            camera_trace_batch(c, &b);
+            for (int j = 0; j < b.n; j++) {
+                reached += pupil_reaches(camera_pupil_at(c, b.wavelength_nm[j]), b.film_point[j]);
+                passed += b.passed[j];
+            }
+            b.n = 0;
+        }
+    }
+    return reached ? (double)passed / (double)reached : NAN;
 }

@@ -45,9 +45,11 @@ typedef struct camera {
     lens lens;                 /* at the chosen film distance and stop opening */
     film film;
     pupil pupil;               /* with dispersion, covering the whole spectrum */
-    /* With dispersion, CAMERA_SPECTRAL_PUPILS pupils fitted at wavelengths evenly spaced over
-       the spectrum, each covering its neighbours' (camera_pupil_at); else NULL. */
+    /* With dispersion, spectral_count pupils (CAMERA_SPECTRAL_PUPILS or more) fitted at
+       wavelengths evenly spaced over the spectrum, each covering its neighbours'
+       (camera_pupil_at); else NULL. */
     pupil *spectral;
+    int spectral_count;
     thick_lens thick;          /* thick lens of the whole lens (for --trace thick and info) */
     double thick_exit_z_mm, thick_exit_radius_mm;   /* --trace thick: the exit pupil, which
                                                        blocks what it does not pass */
@@ -68,7 +70,7 @@ typedef struct camera {
     double unit_mm;
 } camera;
 
-enum { CAMERA_SPECTRAL_PUPILS = 9 };
+enum { CAMERA_SPECTRAL_PUPILS = 9, CAMERA_SPECTRAL_PUPILS_MAX = 65 };
 
 /* The pupil a sample of wavelength nm is drawn from: with dispersion, the spectral pupil
    nearest nm, which holds every ray the lens passes between the midpoints to its neighbours;
@@ -109,6 +111,12 @@ void camera_trace_batch(const camera *c, sample_batch *b);
    point (direction, CAMERA_BATCH of them) and its weight, 0 where the pupil gives none. What
    the trace then gives those that pass, bit for bit. */
 void camera_film_rays(const camera *c, sample_batch *b, vec3 *direction);
+
+/* The share of samples the lens passes, from a probe: 16 x 16 film points over the crop
+   (those the lens reaches), 64 samples each from the film's own sample pattern (pupil points
+   and, with dispersion, wavelengths). 1 is every sample, 0 none; NAN when the lens reaches no
+   film point probed. A low share is a picture that is noisy for its samples per pixel. */
+double camera_pass_share(const camera *c);
 
 /* Camera space (mm) to world (scene units): a point; a difference of points (the rotation and
    the scale without the translation); a direction, normalized. */

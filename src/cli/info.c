@@ -175,6 +175,8 @@ int info_command(const cli *c, l2p_error *err)
                                   : framing_camera_setup(&cam, &copy, &physical, err);
         if (st)
             camera_free(&cam);
+        else
+            cam.glass = glass;   /* the file's, before --wavelength fixed the indices */
     }
     if (!st && with_camera)
         cli_warn(c, &cam, false);

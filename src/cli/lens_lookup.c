@@ -67,6 +67,18 @@ static void warn_crossing(const lens *l)
                 l->surface[i].line, l->surface[i + 1].line, rho, -gap);
 }
 
+/* The last row's index is the medium the film sits in: a film in glass or oil is possible (an
+   immersion lens), but far more often the row was copied from the surface above, and every
+   focal length and f-number is then n times too long. */
+static void warn_film_medium(const lens *l)
+{
+    const lens_surface *rear = &l->surface[l->count - 1];
+    if (rear->ior != 1.0)
+        fprintf(stderr, "lens2pov: warning: %s:%d: the last row's index %g is the medium between "
+                "the rear surface and the film: the film sits in it, not in air (a lens in air "
+                "ends with index 1)\n", l->path, rear->line, rear->ior);
+}
+
 int lens_read_named(const char *name, lens *l, l2p_error *err)
 {
     char *path;
@@ -75,7 +87,9 @@ int lens_read_named(const char *name, lens *l, l2p_error *err)
         return st;
     st = lens_read(path, l, err);
     free(path);
-    if (!st)
+    if (!st) {
         warn_crossing(l);
+        warn_film_medium(l);
+    }
     return st;
 }

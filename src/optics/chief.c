@@ -53,28 +53,34 @@ static bool stop_height(const lens *open, double r, double t, double *x_mm)
     return isfinite(*x_mm);
 }
 
-/* Newton's method from slope *t, the derivative by a forward difference; a step that leaves
-   the lens is halved until it does not. */
-static bool newton(const lens *open, double r, double *t)
+/* Newton's method from slope *t toward the crossing at height target_mm, the derivative by a
+   forward difference; a step that leaves the lens is halved until it does not. */
+static bool newton_to(const lens *open, double r, double target_mm, double *t)
 {
     double h;
     if (!stop_height(open, r, *t, &h))
         return false;
+    h -= target_mm;
     for (int k = 0; k < 60 && fabs(h) > AIM_MM; k++) {
         const double dt = 1e-7 * (1.0 + fabs(*t));
         double h2, next = NAN, step;
-        if (!stop_height(open, r, *t + dt, &h2) || !(h2 != h))
+        if (!stop_height(open, r, *t + dt, &h2) || !(h2 - target_mm != h))
             return false;
-        step = -h * dt / (h2 - h);
+        step = -h * dt / (h2 - target_mm - h);
         int halvings = 0;
         while (!stop_height(open, r, *t + step, &next) && ++halvings < 40)
             step *= 0.5;
         if (halvings == 40)
             return false;
         *t += step;
-        h = next;
+        h = next - target_mm;
     }
     return fabs(h) <= AIM_MM;
+}
+
+static bool newton(const lens *open, double r, double *t)
+{
+    return newton_to(open, r, 0.0, t);
 }
 
 /* A start for newton() when the paraxial aim fails: of the slopes between which the crossing
@@ -130,4 +136,47 @@ bool chief_angle(const chief_lens *c, double film_radius_mm, double *theta_rad)
         return false;
     *theta_rad = atan2(hypot(y.d.x, y.d.y), y.d.z);
     return true;
+}
+
+/* Whether the ray from the film's centre toward height h_mm of the stop's plane gets through
+   l; *blocked the surface that stops it. From slope *t, left at the aimed slope. */
+static bool axial_passes(const chief_lens *c, const lens *l, double h_mm, double *t, int *blocked)
+{
+    if (!newton_to(&c->open, 0.0, h_mm, t))
+        return false;
+    ray y = from_film(0.0, *t);
+    *blocked = -1;
+    return trace_toward_scene(l, 0, l->count - 1, &y, blocked) == TRACE_PASSED;
+}
+
+int chief_axial_limit(const chief_lens *c, const lens *l, double *passing)
+{
+    /* aimed first at the stop's paraxial image's rim (a start on the right side of the lens's
+       fold), then at the stop's rim a hair inside it; bisected between the axis and there */
+    const double rim_mm = 0.999 * 0.5 * l->stop_diameter_mm;
+    double z, radius, t;
+    int blocked;
+    *passing = 1.0;
+    if (pupil_stop_image(l, true, &z, &radius, NULL) != L2P_OK || !(fabs(z) > 1e-9))
+        return -1;
+    t = 0.999 * radius / z;
+    const double t_rim = t;
+    if (axial_passes(c, l, rim_mm, &t, &blocked))
+        return l->stop;
+    if (blocked < 0)
+        return -1;
+    int limit = blocked;   /* the rim that cuts the ray just outside the passing cone */
+    double in = 0.0, out = 1.0;
+    for (int k = 0; k < 30; k++) {
+        const double mid = 0.5 * (in + out);
+        t = t_rim * mid;
+        if (axial_passes(c, l, mid * rim_mm, &t, &blocked))
+            in = mid;
+        else if (blocked >= 0)
+            out = mid, limit = blocked;
+        else
+            return -1;
+    }
+    *passing = in;
+    return limit;
 }

@@ -72,6 +72,7 @@ int pupil_make(const lens *l, pupil_kind kind, pupil *out, l2p_error *err)
             return st;
     }
     out->node_spacing_mm = 0.0;
+    out->chief_spacing_mm = 0.0;
     out->reach_mm = INFINITY;
     if (!(fabs(out->z_mm) > 1e-9 * (1.0 + out->radius_mm)) || !(out->radius_mm > 0.0))
         return l2p_fail(err, L2P_BAD_INPUT, l->path,
@@ -153,6 +154,32 @@ double pupil_shape_radius_mm(const pupil_shape *e, double cos_phi)
     return e->radius_mm[i] + g * (e->radius_mm[i + 1] - e->radius_mm[i]);
 }
 
+/* The chief ray's crossing at film radius r: Catmull-Rom between the tabulated ones, odd about
+   the axis and continued quadratically past the last; constant beyond the table. */
+static double chief_x_at(const pupil *pu, double r_mm)
+{
+    if (!(pu->chief_spacing_mm > 0.0))
+        return 0.0;
+    const double *x = pu->chief_x_mm, t = fmin(r_mm / pu->chief_spacing_mm, PUPIL_CHIEF_SAMPLES);
+    const int i = t < PUPIL_CHIEF_SAMPLES - 1 ? (int)t : PUPIL_CHIEF_SAMPLES - 1;
+    const double f = t - i, p1 = x[i], p2 = x[i + 1];
+    const double p0 = i > 0 ? x[i - 1] : -x[1];
+    const double p3 = i + 2 <= PUPIL_CHIEF_SAMPLES ? x[i + 2] : 3.0 * p2 - 3.0 * p1 + p0;
+    return p1 + 0.5 * f * (p2 - p0 + f * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 +
+                                          f * (3.0 * (p1 - p2) + p3 - p0)));
+}
+
+/* The region's centre at film radius r, in node j at fraction f: the chief ray's crossing plus
+   the two nodes' offsets from theirs (pupil.h). */
+static double centre_at(const pupil *pu, double r_mm, int j, double f)
+{
+    const int per_node = PUPIL_CHIEF_SAMPLES / PUPIL_NODES;
+    const double *chief = pu->chief_spacing_mm > 0.0 ? pu->chief_x_mm : NULL;
+    const double a = pu->node[j].centre_mm - (chief ? chief[j * per_node] : 0.0);
+    const double b = pu->node[j + 1].centre_mm - (chief ? chief[(j + 1) * per_node] : 0.0);
+    return chief_x_at(pu, r_mm) + a + f * (b - a);
+}
+
 bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out)
 {
     if (!pupil_is_fitted(pu)) {
@@ -168,7 +195,7 @@ bool pupil_shape_at(const pupil *pu, double r_mm, pupil_shape *out)
     if (!node_of(pu, r_mm, &j, &f))
         return false;
     const pupil_shape *a = &pu->node[j], *b = &pu->node[j + 1];
-    out->centre_mm = a->centre_mm + f * (b->centre_mm - a->centre_mm);
+    out->centre_mm = centre_at(pu, r_mm, j, f);
     for (int i = 0; i <= PUPIL_KNOTS; i++)
         out->radius_mm[i] = a->radius_mm[i] + f * (b->radius_mm[i] - a->radius_mm[i]);
     return true;
@@ -190,8 +217,7 @@ static bool locate(const pupil *pu, vec3 p, double *cx, double *cy, double *c, d
     }
     if (!node_of(pu, r, j, f))
         return false;
-    const pupil_shape *a = &pu->node[*j], *b = &pu->node[*j + 1];
-    const double centre = a->centre_mm + *f * (b->centre_mm - a->centre_mm);
+    const double centre = centre_at(pu, r, *j, *f);
     *cx = centre * *c;
     *cy = centre * *s;
     return true;

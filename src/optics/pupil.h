@@ -28,8 +28,9 @@ typedef struct pupil_shape {
     double radius_mm[PUPIL_KNOTS + 1];
 } pupil_shape;
 
-/* Film radii at which the shapes are tabulated, from 0 to the largest film radius. */
-enum { PUPIL_NODES = 32 };
+/* Film radii at which the shapes are tabulated, from 0 to the largest film radius, and the
+   chief ray's crossings (PUPIL_CHIEF_SAMPLES / PUPIL_NODES of them a node). */
+enum { PUPIL_NODES = 32, PUPIL_CHIEF_SAMPLES = 4096 };
 
 typedef struct pupil {
     pupil_kind kind;
@@ -41,6 +42,13 @@ typedef struct pupil {
        samples nothing: no ray from it gets through the lens. */
     double node_spacing_mm, reach_mm;
     pupil_shape node[PUPIL_NODES + 1];
+    /* Where the chief ray of film radius i * chief_spacing_mm crosses the pupil plane (x, mm),
+       for stop-image's fit (chief_spacing_mm = 0: none). The region's centre at film radius r
+       is this, interpolated as a cubic, plus the nodes' offsets from it interpolated linearly:
+       the centre moves with r faster than linearly (pupil aberration), and a region smaller
+       than linear interpolation's error between nodes, a tiny stop's, would be missed. */
+    double chief_spacing_mm;
+    double chief_x_mm[PUPIL_CHIEF_SAMPLES + 1];
 } pupil;
 
 /* Name as used on the command line: "stop", "rear", "stop-image". */

@@ -120,17 +120,47 @@ static double search_half_side_mm(const pupil *pu, const lens *l, double r)
 }
 
 /* Where the chief ray of film radius r crosses the pupil plane: inside the region unless a rim
-   cuts it, however small the stop (a region far smaller than the scan's step is found there). */
+   cuts it, however small the stop. */
+static bool chief_crossing(const chief_lens *c, const pupil *pu, double r, double *x)
+{
+    double slope;
+    const bool ok = chief_slope(c, r, &slope);
+    *x = r + slope * pu->z_mm;
+    return ok && isfinite(*x);
+}
+
+/* The same for one radius (a region far smaller than the scan's step is found there). */
 static bool chief_point(const pupil *pu, const lens *l, double r, double *x)
 {
     chief_lens c;
-    double slope;
     if (chief_lens_open(&c, l))
         return false;
-    const bool ok = chief_slope(&c, r, &slope);
+    const bool ok = chief_crossing(&c, pu, r, x);
     chief_lens_close(&c);
-    *x = r + slope * pu->z_mm;
-    return ok && isfinite(*x);
+    return ok;
+}
+
+/* The chief ray's crossings out to film radius r (pupil.h), for stop-image. Where no chief ray
+   gets through (beyond a fisheye's image circle) the table goes on along the line through the
+   last two found; with fewer than two found there is none, and the nodes' centres alone give
+   the centre. */
+static void tabulate_chief(pupil *pu, const lens *l, double film_radius_mm)
+{
+    chief_lens c;
+    pu->chief_spacing_mm = 0.0;
+    if (pu->kind != PUPIL_STOP_IMAGE || chief_lens_open(&c, l))
+        return;
+    const double spacing = film_radius_mm / PUPIL_CHIEF_SAMPLES;
+    int found = 0;
+    while (found <= PUPIL_CHIEF_SAMPLES &&
+           chief_crossing(&c, pu, found * spacing, &pu->chief_x_mm[found]))
+        found++;
+    chief_lens_close(&c);
+    if (found < 2)
+        return;
+    for (int i = found; i <= PUPIL_CHIEF_SAMPLES; i++)
+        pu->chief_x_mm[i] = 2.0 * pu->chief_x_mm[i - 1] - pu->chief_x_mm[i - 2];
+    pu->chief_spacing_mm = spacing;
 }
 
 /* A passing point of the x axis: the guess, then points a quarter of size apart either side
@@ -277,12 +307,22 @@ static void grow(pupil_shape *e, double factor)
         e->radius_mm[i] *= factor;
 }
 
+/* The chief ray's crossing at node j, 0 without the table. */
+static double chief_at_node(const pupil *pu, int j)
+{
+    return pu->chief_spacing_mm > 0.0 ? pu->chief_x_mm[j * (PUPIL_CHIEF_SAMPLES / PUPIL_NODES)] : 0.0;
+}
+
 /* The nodes' shapes where the region is found; found[j] says where. The guess for each node
-   continues the two before it. */
+   continues the two before it, or with the chief rays tabulated, the chief ray's crossing
+   moved by the last node's offset from it. */
 static void fit_nodes(pupil *pu, const lens *l, bool *found)
 {
-    double guess = 0.0, size = pu->radius_mm;
+    const bool chief = pu->chief_spacing_mm > 0.0;
+    double guess = 0.0, size = pu->radius_mm, offset = 0.0;
     for (int j = 0; j <= PUPIL_NODES; j++) {
+        if (chief)
+            guess = chief_at_node(pu, j) + offset;
         const region g = find_region(pu, l, j * pu->node_spacing_mm, guess, size);
         found[j] = g.found;
         if (!g.found)
@@ -292,13 +332,16 @@ static void fit_nodes(pupil *pu, const lens *l, bool *found)
             pu->node[0] = disk(size_of(&pu->node[0]));
         const double previous = j > 0 && found[j - 1] ? pu->node[j - 1].centre_mm : pu->node[j].centre_mm;
         guess = 2.0 * pu->node[j].centre_mm - previous;
+        offset = pu->node[j].centre_mm - chief_at_node(pu, j);
         size = size_of(&pu->node[j]);
     }
 }
 
 /* The film radius beyond which nothing passes, when the last nodes find nothing: bisected
    between the last node that finds the region and the first that does not, and at least the
-   radius where the search last found it. Fills the empty nodes with the last found shape;
+   radius where the search last found it. Fills the empty nodes with the last found shape,
+   at the same offset from the chief ray's crossing (the centre between the last found node
+   and the reach follows the chief ray, pupil.h);
    INFINITY when every node or none finds the region, or when one is found after a gap. */
 static double find_reach(pupil *pu, const lens *l, const bool *found)
 {
@@ -307,8 +350,10 @@ static double find_reach(pupil *pu, const lens *l, const bool *found)
         if (found[j])
             last = j;
     for (int j = 1; j <= PUPIL_NODES; j++)
-        if (!found[j])
+        if (!found[j]) {
             pu->node[j] = pu->node[j - 1];
+            pu->node[j].centre_mm += chief_at_node(pu, j) - chief_at_node(pu, j - 1);
+        }
     if (last < 0 || last == PUPIL_NODES)
         return INFINITY;
     for (int j = 0; j < last; j++)
@@ -371,6 +416,7 @@ void pupil_fit(pupil *pu, const lens *l, double film_radius_mm)
     pu->node_spacing_mm = film_radius_mm / PUPIL_NODES;
     for (int j = 0; j <= PUPIL_NODES; j++)
         pu->node[j] = disk(pu->radius_mm);
+    tabulate_chief(pu, l, film_radius_mm);
     fit_nodes(pu, l, found);
     pu->reach_mm = find_reach(pu, l, found);
     check_between(pu, l);
