@@ -77,7 +77,8 @@ static void face_colour(int k, float rgb[3])
 }
 
 /* Chunk k's render, RGBA, with the row work-around: image row y >= 1 shows face row y - 1.
-   Row 0 and the slots past the last face hold garbage that must never be read. */
+   Row 0 holds garbage that must never be read; the slots past the last face are black, as
+   POV-Ray leaves them (develop checks that). */
 static float *make_render(int chunk, int *width, int *height)
 {
     const int rows = chunk < 2 ? 2 : 1;
@@ -88,7 +89,9 @@ static float *make_render(int chunk, int *width, int *height)
         for (int x = 0; x < PW; x++) {
             float *p = px + 4 * (y * PW + x);
             const int face = chunk * CHUNK + (y - 1) * PW + x;
-            if (y == 0 || face >= FACES) {
+            if (face >= FACES && y > 0) {
+                p[0] = p[1] = p[2] = p[3] = 0.0f;
+            } else if (y == 0) {
                 p[0] = NAN;
                 p[1] = 1e30f;
                 p[2] = -7.0f;

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include "base/outfile.h"
 #include "field/field_develop.h"
@@ -224,16 +225,32 @@ static void warn_older(const char *map_path, char *const *renders, long long cou
                     "trace? (render the trace's .ini again)\n", renders[k], map_path);
 }
 
+/* POV-Ray's other formats (+FN, +FT, +FJ, ...) clip values above 1, the highlights a lens
+   spreads into bokeh, and quantize the rest: said, not refused (a user may know the scene
+   has neither). The trace's .ini asks for EXR. */
+static void warn_not_exr(char *const *renders, long long count)
+{
+    for (long long k = 0; k < count; k++) {
+        const size_t n = renders[k] ? strlen(renders[k]) : 0;
+        if (n && (n < 4 || strcasecmp(renders[k] + n - 4, ".exr") != 0))
+            fprintf(stderr, "lens2pov: warning: %s is not an OpenEXR render: POV-Ray's other "
+                    "formats clip values above 1 and round the rest (the trace's .ini asks for "
+                    "EXR)\n", renders[k]);
+    }
+}
+
 /* The picture must not replace the map or a render it is developed from; a render older than
-   the map is warned of. */
+   the map, or not an EXR, is warned of. */
 static int check_inputs(const cli *c, const char *map_path, char *const *renders, long long count,
                         l2p_error *err)
 {
     int st = outfile_check_not_input(c->output, map_path, "the sample map", err);
     for (long long k = 0; !st && k < count; k++)
         st = outfile_check_not_input(c->output, renders[k], "a render to develop", err);
-    if (!st)
+    if (!st) {
         warn_older(map_path, renders, count);
+        warn_not_exr(renders, count);
+    }
     return st;
 }
 

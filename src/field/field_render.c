@@ -260,7 +260,8 @@ static int write_includes(writing *w, int threads, l2p_error *err)
 /* Its ini: (W+1) x (H+1) pixels, rows 2.. and columns ..W only (FS#261, docs/povray.md), and
    of those only the grid's (POV-Ray still searches the faces for a pixel no face covers, at
    about the cost of a pixel that one does), the picture named by its absolute path. */
-static int write_ini(const field_render_plan *p, const char *exr, outfile *f, l2p_error *err)
+static int write_ini(const camera *c, const field_render_plan *p, const char *exr, outfile *f,
+                     l2p_error *err)
 {
     char *path = chunk_ini_absolute(exr);
     if (!path)
@@ -276,6 +277,7 @@ static int write_ini(const field_render_plan *p, const char *exr, outfile *f, l2
                    "End_Column=%d\nAntialias=Off\n"
                    "Output_File_Type=E\nOutput_To_File=On\nOutput_File_Name=%s%s%s\nDisplay=Off\n",
             p->width + 1, p->height + 1, p->used_height + 1, p->used_width, q, path, q);
+    chunk_ini_as_render(f->fp, c->film.width, c->film.height);
     free(path);
     return outfile_finish(f, err);
 }
@@ -448,7 +450,7 @@ static int build_files(const camera *c, const field_files_request *q, field_file
         if (!ch->include_path || !ch->ini_path || !ch->output_exr)
             st = l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
         if (!st && !(st = outfile_open(&out->ini[r], ch->ini_path, err)))
-            st = write_ini(&plans[r], ch->output_exr, &out->ini[r], err);
+            st = write_ini(c, &plans[r], ch->output_exr, &out->ini[r], err);
     }
     if (!st) {
         writing w = {.c = c, .subs = subs, .plans = plans, .placement = q->placement,

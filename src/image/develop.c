@@ -87,11 +87,33 @@ static int add_sample(const samplemap *map, const double (*colour)[3], long long
     return L2P_OK;
 }
 
+/* The end of the last row, past the table, has no face: POV-Ray leaves it black. Colour there
+   is a render made through another camera: another trace's table, longer than this one, or
+   the scene's own camera, when the include came before the scene (POV-Ray keeps the last
+   camera) or not at all. */
+static int check_unused_end(const samplemap_header *h, long long chunk, const float *rgba,
+                            int width, int height, l2p_error *err)
+{
+    const long long first = chunk * h->chunk_faces, used = h->faces - first;
+    for (long long i = used; i < (long long)(height - 1) * width; i++) {
+        const float *p = rgba + 4 * (size_t)(width + i);   /* face i sits one row down */
+        if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f)
+            return l2p_fail(err, L2P_BAD_INPUT, NULL, 0, "pixel (%lld, %d) of the render, past "
+                            "the last ray, is not black: the render was not made through this "
+                            "trace's include (a render of another trace, or one whose scene set "
+                            "its camera after the include: POV-Ray keeps the last camera)",
+                            i % width, height - 1);
+    }
+    return L2P_OK;
+}
+
 int develop_accumulate(const samplemap *map, long long chunk, const float *rgba, int width,
                        int height, double *sums, l2p_error *err)
 {
     const samplemap_header *h = &map->header;
     int st = check_chunk_image(h, chunk, width, height, err);
+    if (!st)
+        st = check_unused_end(h, chunk, rgba, width, height, err);
     if (st)
         return st;
     double (*colour)[3] = band_weights(h);

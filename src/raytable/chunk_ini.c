@@ -34,8 +34,16 @@ int chunk_ini_check_prefix(const char *prefix, l2p_error *err)
     return st;
 }
 
+void chunk_ini_as_render(FILE *fp, int film_width, int film_height)
+{
+    fprintf(fp, "; As render runs POV-Ray: a scene without gamma handling decoded as sRGB, and the\n"
+                "; film's size, not the packed image's, as image_width and image_height.\n"
+                "Display_Gamma=sRGB\nDeclare=image_width=%d\nDeclare=image_height=%d\n",
+            film_width, film_height);
+}
+
 int chunk_ini_write(outfile *ini, const char *ini_path, const char *exr_path, int width,
-                    long long height, l2p_error *err)
+                    long long height, int film_width, int film_height, l2p_error *err)
 {
     char *exr = chunk_ini_absolute(exr_path);
     int st = !exr ? l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory")
@@ -50,6 +58,7 @@ int chunk_ini_write(outfile *ini, const char *ini_path, const char *exr_path, in
                 "Width=%d\nHeight=%lld\nStart_Row=0.0\nEnd_Row=1.0\nStart_Column=0.0\n"
                 "End_Column=1.0\nAntialias=Off\nOutput_File_Type=E\nOutput_To_File=On\n"
                 "Output_File_Name=%s%s%s\nDisplay=Off\n", width, height, quote, exr, quote);
+        chunk_ini_as_render(ini->fp, film_width, film_height);
     }
     free(exr);
     return st ? st : outfile_finish(ini, err);

@@ -179,7 +179,8 @@ static void put_camera(text_out *t, const povmesh_emitter *e)
 static int write_ini(povmesh_emitter *e, chunk *ch, int index, long long rows, l2p_error *err)
 {
     char *path = chunk_path(e, index, "ini"), *exr = chunk_path(e, index, "exr");
-    const int st = path && exr ? chunk_ini_write(&ch->ini, path, exr, e->packed_width, rows + 1, err)
+    const int st = path && exr ? chunk_ini_write(&ch->ini, path, exr, e->packed_width, rows + 1,
+                                                         e->cam->film.width, e->cam->film.height, err)
                                : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     free(path);
     free(exr);
