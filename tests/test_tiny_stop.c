@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "camera/camera.h"
 #include "optics/trace.h"
@@ -206,14 +207,17 @@ Test(tiny_stop, a_stop_that_few_samples_pass_is_warned_of)
     cr_expect(share > 0.0 && probe / 100.0 > 0.5 * share && probe / 100.0 < 2.0 * share,
               "probe %g%% against %g%%", probe, 100.0 * share);
     cr_expect(strstr(errtext, "--dispersion off"), "%s", errtext);
+    free(out), free(errtext);
     cr_assert_eq(run_lens2pov(&out, &errtext, "trace", lens, "--width", "64", "--height", "48",
                               "--aperture-diameter", "0.00001", "--sampling", "pixel", "-o",
                               tmp_path(dir, "none"), NULL), 0, "%s", errtext);
     cr_expect(strstr(errtext, "the picture will be black"), "%s", errtext);
     cr_expect_eq(reported_share(errtext), 0.0);
+    free(out), free(errtext);
     cr_assert_eq(run_lens2pov(&out, &errtext, "trace", lens, "--width", "64", "--height", "48",
                               "--f-number", "16", "--sampling", "pixel", "-o",
                               tmp_path(dir, "f16"), NULL), 0, "%s", errtext);
     cr_expect(!strstr(errtext, "get through the lens"), "%s", errtext);
+    free(out), free(errtext);
     remove_tree(dir);
 }

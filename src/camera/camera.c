@@ -1,8 +1,11 @@
 #include "camera/camera.h"
 
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "base/cores.h"
+#include "base/workers.h"
 #include "optics/focus.h"
 #include "optics/spectrum.h"
 #include "optics/trace_batch.h"
@@ -131,9 +134,11 @@ static int check_film_position(const lens *l, bool from_option, double focus_mm,
                         "--film-distance %g mm is too far from the lens: %.3g times its size, at "
                         "most %g", l->film_distance_mm, l->film_distance_mm / size,
                         FILM_DISTANCE_MAX_RATIO);
+    char focus[48];
+    snprintf(focus, sizeof focus, isinf(focus_mm) ? "at infinity" : "at %g mm", focus_mm);
     return l2p_fail(err, L2P_BAD_INPUT, l->path, l->surface[0].line,
-                    "focusing at %g mm puts the film %g mm behind the lens, too far from it "
-                    "(%.3g times its size, at most %g): the lens is nearly afocal", focus_mm,
+                    "focusing %s puts the film %g mm behind the lens, too far from it (%.3g "
+                    "times its size, at most %g): the lens is nearly afocal", focus,
                     l->film_distance_mm, l->film_distance_mm / size, FILM_DISTANCE_MAX_RATIO);
 }
 
@@ -336,32 +341,72 @@ static double grown_area(const pupil *a, const pupil *b)
    wavelength. */
 #define SPECTRAL_WORTH 1.5
 
+/* The spectral pupils' fits, shared by the threads that make them. */
+typedef struct spectral_job {
+    camera *c;
+    int count;
+    atomic_int next;
+    atomic_int status;
+    double growth[CAMERA_SPECTRAL_PUPILS_MAX];   /* each pupil's growth in the covering */
+    l2p_error err;                              /* the first failure's */
+} spectral_job;
+
+/* Pupil i fitted at its wavelength in the plane of c->pupil, then covered at its neighbours'. */
+static int fit_one_spectral(spectral_job *j, int i, pupil *own, l2p_error *err)
+{
+    camera *c = j->c;
+    pupil *p = &c->spectral[i];
+    *p = c->pupil;
+    int st = fit_at(p, &c->lens, spectral_nm(i, j->count), 0.5 * c->film.diagonal_mm, err);
+    *own = *p;
+    if (!st && i > 0)
+        st = cover_at(p, &c->lens, spectral_nm(i - 1, j->count), err);
+    if (!st && i + 1 < j->count)
+        st = cover_at(p, &c->lens, spectral_nm(i + 1, j->count), err);
+    if (!st)
+        j->growth[i] = grown_area(own, p);
+    return st;
+}
+
+static void *spectral_worker(void *arg)
+{
+    spectral_job *j = arg;
+    pupil *own = malloc(sizeof *own);
+    l2p_error err;
+    int st = own ? L2P_OK : l2p_fail(&err, L2P_FAILED, NULL, 0, "out of memory");
+    for (int i; !st && (i = atomic_fetch_add(&j->next, 1)) < j->count;)
+        st = fit_one_spectral(j, i, own, &err);
+    int none = L2P_OK;
+    if (st && atomic_compare_exchange_strong(&j->status, &none, st))
+        j->err = err;
+    free(own);
+    return NULL;
+}
+
 /* Fits count spectral pupils, each at its wavelength in the plane of c->pupil and covered at
-   its neighbours'; *growth is the most any grew in the covering (grown_area). */
+   its neighbours', on every core (the fits are independent); *growth is the most any grew in
+   the covering (grown_area). */
 static int fit_spectral(camera *c, int count, double *growth, l2p_error *err)
 {
-    pupil *own = malloc(sizeof *own);
+    spectral_job *j = malloc(sizeof *j);
     free(c->spectral);
     c->spectral_count = count;
-    if (!own || !(c->spectral = malloc(sizeof *c->spectral * (size_t)count))) {
-        free(own);
+    if (!j || !(c->spectral = malloc(sizeof *c->spectral * (size_t)count))) {
+        free(j);
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
-    int st = L2P_OK;
+    j->c = c;
+    j->count = count;
+    atomic_init(&j->next, 0);
+    atomic_init(&j->status, L2P_OK);
+    workers_run(spectral_worker, j, cores_online() < count ? cores_online() : count);
+    const int st = atomic_load(&j->status);
     *growth = 1.0;
-    for (int i = 0; i < count && !st; i++) {
-        pupil *p = &c->spectral[i];
-        *p = c->pupil;
-        st = fit_at(p, &c->lens, spectral_nm(i, count), 0.5 * c->film.diagonal_mm, err);
-        *own = *p;
-        if (!st && i > 0)
-            st = cover_at(p, &c->lens, spectral_nm(i - 1, count), err);
-        if (!st && i + 1 < count)
-            st = cover_at(p, &c->lens, spectral_nm(i + 1, count), err);
-        if (!st)
-            *growth = fmax(*growth, grown_area(own, p));
-    }
-    free(own);
+    for (int i = 0; !st && i < count; i++)
+        *growth = fmax(*growth, j->growth[i]);
+    if (st)
+        *err = j->err;
+    free(j);
     return st;
 }
 

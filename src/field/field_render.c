@@ -16,6 +16,7 @@
 #include "field/fieldrays.h"
 #include "field/strata.h"
 #include "field/subimage.h"
+#include "base/workers.h"
 #include "raytable/chunk_ini.h"
 #include "optics/pupil.h"
 #include "povray/povray.h"
@@ -125,23 +126,9 @@ static void *build_worker(void *arg)
     return NULL;
 }
 
-/* worker(arg) on up to threads threads (at most 64), or on this one when none starts. */
-static void run_workers(void *(*worker)(void *), void *arg, int threads)
-{
-    pthread_t t[64];
-    int started = 0;
-    for (int i = 0; i < threads && i < 64; i++)
-        if (pthread_create(&t[started], NULL, worker, arg) == 0)
-            started++;
-    if (started == 0)
-        worker(arg);
-    for (int i = 0; i < started; i++)
-        pthread_join(t[i], NULL);
-}
-
 static int build_all(job *j, int threads, l2p_error *err)
 {
-    run_workers(build_worker, j, threads);
+    workers_run(build_worker, j, threads);
     if (atomic_load(&j->status))
         *err = j->err;
     return atomic_load(&j->status);
@@ -249,7 +236,7 @@ static int write_includes(writing *w, int threads, l2p_error *err)
     atomic_init(&w->next, 0);
     atomic_init(&w->status, L2P_OK);
     pthread_mutex_init(&w->lock, NULL);
-    run_workers(write_worker, w, threads < w->renders ? threads : w->renders);
+    workers_run(write_worker, w, threads < w->renders ? threads : w->renders);
     pthread_mutex_destroy(&w->lock);
     const int st = atomic_load(&w->status);
     if (st)
