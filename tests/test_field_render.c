@@ -432,3 +432,18 @@ Test(field_render, a_bad_weights_bound_in_the_environment_is_refused)
         free(errtext);
     }
 }
+
+/* --memory-mb splits pixel sampling's ray tables; a field render is bounded already, and a
+   user who asks for a bound there is told that it changes nothing. */
+Test(field_render, memory_mb_is_said_to_change_nothing)
+{
+    const char *dir = test_tmpdir(), *scene = tmp_path(dir, "s.pov");
+    write_text(scene, SCENE);
+    char *errtext = NULL;
+    cr_assert_eq(L2P(NULL, &errtext, "render", scene, LENS_DIR "dgauss.50mm.dat", "--width", "32",
+                     "--height", "24", "--spp", "4", "--sampling", "field", "--memory-mb", "100",
+                     "-q", "-o", tmp_path(dir, "a.png")), 0, "%s", errtext);
+    cr_expect(strstr(errtext, "--memory-mb splits the ray tables of --sampling pixel"), "%s",
+              errtext);
+    free(errtext);
+}

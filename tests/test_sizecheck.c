@@ -218,8 +218,9 @@ static double render_side(int n)
 
 /* Each sub-image's render is its own size: (2^a) x (2^b) pixels, the final picture 2^a - 1 by
    2^b - 1 holding the crop (docs/fields.md), 8 bytes a pixel, whatever the film around the
-   crop, plus POV-Ray's state files of the renders at once; and the faces are not pixel
-   sampling's one a sample. */
+   crop, plus POV-Ray's state files of the renders at once: the disk counts whole sub-images'
+   renders, at least the two pictures a process holds; and the faces are not pixel sampling's
+   one a sample. */
 Test(sizecheck, field_renders_are_estimated_at_their_own_size)
 {
     static const int sides[][2] = {{511, 255}, {512, 256}, {100, 700}, {1, 1}};
@@ -233,12 +234,16 @@ Test(sizecheck, field_renders_are_estimated_at_their_own_size)
         char *pixel[] = {"s.pov", "dgauss.50mm", "--width", w, "--height", h, "--crop", crop, "--spp", "64",
                          "-o", "x.png"};
         const size_estimate f = estimate_of(field, 14, 2), p = estimate_of(pixel, 12, 2);
-        const double want = 64 * render_side(sides[i][0]) * render_side(sides[i][1]) * SIZE_EXR_BYTES_PER_FACE;
+        const double own = render_side(sides[i][0]) * render_side(sides[i][1]);
+        const double all = 64 * own * SIZE_EXR_BYTES_PER_FACE;
         /* and the state files of the two renders at once, each at most 2^24 pixels here */
         const double most_state = 2 * 16777216.0 * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
-        cr_expect(f.renders_bytes > want && f.renders_bytes <= want + most_state,
-                  "crop %dx%d: %.0f bytes of renders, expected %.0f and the state files", sides[i][0],
-                  sides[i][1], f.renders_bytes, want);
+        /* pictures (two a process, of at least one sub-image each) and state files of whole
+           sub-images' renders */
+        cr_expect(f.renders_bytes >= 4 * own * SIZE_EXR_BYTES_PER_FACE &&
+                  f.renders_bytes <= all + most_state && fmod(f.renders_bytes, own) == 0.0,
+                  "crop %dx%d: %.0f bytes of renders, not whole renders of %.0f pixels (all: %.0f "
+                  "bytes)", sides[i][0], sides[i][1], f.renders_bytes, own, all);
         cr_expect_leq(f.faces, p.faces, "crop %dx%d: %.0f faces against %.0f", sides[i][0], sides[i][1], f.faces,
                      p.faces);
     }

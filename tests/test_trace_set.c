@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "image/image_io.h"
 #include "support.h"
@@ -241,5 +242,34 @@ Test(trace_set, a_render_that_is_not_exr_is_warned_of)
     char want[1200];
     snprintf(want, sizeof want, "warning: %s is not an OpenEXR render", png);
     cr_expect(strstr(errtext, want), "%s", errtext);
+    free(errtext);
+}
+
+/* render renders a chunk as soon as it is written, before the map, which is renamed into place
+   last: the map takes the time the table was begun, so that its own renders are never older
+   than it (develop of a kept folder warned of every chunk rendered before the trace ended). */
+Test(trace_set, a_kept_renders_map_is_not_newer_than_its_renders)
+{
+    const char *dir = test_tmpdir();
+    char keep[1024], scene[1100];
+    snprintf(keep, sizeof keep, "%s/kept", dir);
+    snprintf(scene, sizeof scene, "%s/s.pov", dir);
+    write_text(scene, "background { rgb 0.5 }\n");
+    run_lens2pov_ok("render", "render", scene, DGAUSS, "--width", "96", "--height", "72", "--spp",
+                    "8", "--sampling", "pixel", "--memory-mb", "2", "--keep-temp", keep, "-q", "-o",
+                    tmp_path(dir, "a.png"), (char *)NULL);
+    struct stat map, first;
+    cr_assert_eq(stat(tmp_path(keep, "rays.map"), &map), 0);
+    cr_assert_eq(stat(tmp_path(keep, "rays.c000.inc"), &first), 0, "not chunked");
+    cr_assert(file_exists(tmp_path(keep, "rays.c001.inc")), "one chunk only");
+    cr_expect(map.st_mtim.tv_sec < first.st_mtim.tv_sec ||
+              (map.st_mtim.tv_sec == first.st_mtim.tv_sec &&
+               map.st_mtim.tv_nsec <= first.st_mtim.tv_nsec),
+              "the map is newer than the first chunk's include");
+    char prefix[1100], *errtext = NULL;
+    snprintf(prefix, sizeof prefix, "%s/rays", keep);
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "b.png"),
+                              (char *)NULL), 0, "%s", errtext);
+    cr_expect(!strstr(errtext, "older than"), "%s", errtext);
     free(errtext);
 }

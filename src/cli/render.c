@@ -75,6 +75,10 @@ static int check_inputs(const cli *c, l2p_error *err)
     double weights_bytes;
     if (!st && c->field_sampling)
         st = field_weights_kept_bytes(&weights_bytes, err);
+    if (!st && c->field_sampling && c->memory_mb > 0)
+        fprintf(stderr, "lens2pov: warning: --memory-mb splits the ray tables of --sampling pixel; "
+                        "a field render's POV-Ray processes are bounded by their faces and "
+                        "pictures already: it changes nothing here\n");
     return st ? st : check_workspace_path(c, err);
 }
 

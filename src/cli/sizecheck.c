@@ -8,6 +8,8 @@
 #include <sys/statvfs.h>
 #include <sys/sysinfo.h>
 #include "field/field_render.h"
+#include "field/field_files.h"
+#include "field/fieldpack.h"
 #include "field/fieldpass.h"
 #include "field/subimage.h"
 #include "raytable/raytable.h"
@@ -73,6 +75,7 @@ typedef struct field_layout {
     double subimage_pixels;    /* a sub-image's render, had it one of its own */
     double render_faces;       /* a render's faces, at most */
     double render_pixels;      /* a render's picture, at most */
+    double typical_render_pixels;   /* and with the faces estimated */
     double at_once;            /* POV-Ray processes at once, at most */
 } field_layout;
 
@@ -83,18 +86,21 @@ typedef struct field_layout {
    faces proportional to width plus height, and to 1 / tolerance below the default (the edges
    stay as fine above it), plus the coarsest grid's; a sub-image with more faces than pixels
    is refused. */
-static double field_subimage_faces(const cli *c, int w, int h, double coarsest)
+static double field_subimage_faces(const cli *c, int w, int h, double coarsest, double per_side)
 {
     const double finer = fmax(1.0, FIELD_DEFAULT_TOLERANCE_PX / c->field_tolerance);
-    const double faces = SIZE_FIELD_FACES_PER_SIDE_PIXEL * (w + h) * finer + coarsest;
+    const double faces = per_side * (w + h) * finer + coarsest;
     return fmax(1.0, fmin(faces, (double)w * h));
 }
 
 /* field_render packs consecutive sub-images into a render up to FIELD_FACES_PER_RENDER faces
    and FIELD_PIXELS_PER_RENDER pixels, and at most spp / jobs (rounded up), at least one. Its
    picture, 2^a x 2^b, is never larger than its sub-images' own renders' pictures together;
-   every later render has the first one's size. */
-static field_layout field_layout_of(const cli *c, int jobs)
+   every later render has the first one's size. That bound holds a render's memory; its disk,
+   which runs out more gently (the run fails, the outputs kept), is taken at the count the
+   packing chooses for the estimated faces: the pixels' bound alone counted 30 times the disk
+   renders at 640 x 480 take, and refused them on a small /tmp. */
+static field_layout field_layout_of(const cli *c, int jobs, double per_side)
 {
     int w, h;
     crop_size(&c->cam, &w, &h);
@@ -102,11 +108,15 @@ static field_layout field_layout_of(const cli *c, int jobs)
     const double cells = ceil((w - 1.0) / FIELD_COARSEST_CELL) * ceil((h - 1.0) / FIELD_COARSEST_CELL);
     const double coarsest = fmax(1.0, 2.0 * cells);
     const double most = ceil(l.spp / (jobs > 0 ? jobs : 1));
-    l.subimage_faces = field_subimage_faces(c, w, h, coarsest);
+    l.subimage_faces = field_subimage_faces(c, w, h, coarsest, per_side);
     l.subimage_pixels = (field_render_size(w) + 1.0) * (field_render_size(h) + 1.0);
     const double fit = fmax(1.0, floor(FIELD_PIXELS_PER_RENDER / l.subimage_pixels));
     l.render_faces = fmin(most * l.subimage_faces, fmax(FIELD_FACES_PER_RENDER, l.subimage_faces));
     l.render_pixels = fmin(most, fit) * l.subimage_pixels;
+    /* as field_pack_grid packs sub-images of the estimated faces, at the larger overhead */
+    const int spp = c->cam.spp, renders = field_pack_count_estimate(spp, w, h, jobs > 0 ? jobs : 1,
+                                                                     l.subimage_faces, FIELD_FRAME_S);
+    l.typical_render_pixels = fmin(l.render_pixels, ceil((double)spp / renders) * l.subimage_pixels);
     l.at_once = fmin(jobs > 0 ? jobs : 1, l.spp);
     return l;
 }
@@ -146,9 +156,9 @@ static void field_memory(const field_layout *l, int jobs, size_estimate *e)
    developed (field_povray.c) unless the folder is kept: renders are developed in their order
    as they come, so besides the one each POV-Ray process is writing, about one a process waits
    for those before it. With POV-Ray's own options a frame's EXRs wait for the whole frame. */
-static size_estimate field_estimate(const cli *c, int jobs)
+static size_estimate field_estimate(const cli *c, int jobs, double per_side)
 {
-    const field_layout l = field_layout_of(c, jobs);
+    const field_layout l = field_layout_of(c, jobs, per_side);
     size_estimate e = {.faces = l.spp * l.subimage_faces};
     const bool weights_on_disk = jobs == 0 || c->keep_temp;
     e.table_bytes = e.faces * SIZE_FIELD_INCLUDE_BYTES_PER_FACE +
@@ -157,10 +167,11 @@ static size_estimate field_estimate(const cli *c, int jobs)
     e.csv_bytes = c->rays_csv ? l.spp * l.pixels * SIZE_FIELD_CSV_BYTES_PER_ROW : 0.0;
     if (jobs > 0) {
         const double all = l.spp * l.subimage_pixels;
-        const double pictures = c->keep_temp || c->povray_args ? all
-                                                               : fmin(all, 2 * l.at_once * l.render_pixels);
+        const double pictures = c->keep_temp || c->povray_args
+                                    ? all
+                                    : fmin(all, 2 * l.at_once * l.typical_render_pixels);
         e.renders_bytes = pictures * SIZE_EXR_BYTES_PER_FACE +
-                          l.at_once * l.render_pixels * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
+                          l.at_once * l.typical_render_pixels * SIZE_POVRAY_STATE_BYTES_PER_PIXEL;
         field_memory(&l, jobs, &e);
     }
     return e;
@@ -168,7 +179,15 @@ static size_estimate field_estimate(const cli *c, int jobs)
 
 size_estimate size_estimate_of(const cli *c, int jobs)
 {
-    return c->field_sampling ? field_estimate(c, jobs) : pixel_estimate(c, jobs);
+    return c->field_sampling ? field_estimate(c, jobs, SIZE_FIELD_FACES_PER_SIDE_PIXEL)
+                             : pixel_estimate(c, jobs);
+}
+
+/* The estimate whose disk is refused: field sampling's at the common lens's faces. */
+static size_estimate disk_estimate_of(const cli *c, int jobs)
+{
+    return c->field_sampling ? field_estimate(c, jobs, SIZE_FIELD_FACES_TYPICAL_PER_SIDE_PIXEL)
+                             : pixel_estimate(c, jobs);
 }
 
 /* "845 GB", "12.3 MB". */
@@ -219,14 +238,16 @@ static int refuse(const cli *c, const char *what, double need, double have, cons
 {
     char a[32], b[32];
     const camera_options *o = &c->cam;
+    /* memory also goes with the POV-Ray processes at once, disk not */
     return l2p_fail(err, L2P_BAD_INPUT, NULL, 0,
                     "%.0f pixels x --spp %d is up to %.3g rays: about %s of %s%s%s, %s available; "
-                    "give fewer pixels or samples (or --no-size-check to try anyway)",
+                    "give fewer pixels or samples%s (or --no-size-check to try anyway)",
                     crop_pixels(o), o->spp, crop_pixels(o) * o->spp, human(need, a), what,
-                    where ? " in " : "", where ? where : "", human(have, b));
+                    where ? " in " : "", where ? where : "", human(have, b),
+                    where ? "" : ", or fewer --jobs");
 }
 
-static int check_disk(const cli *c, const disk_need *needs, int n, l2p_error *err)
+static int check_disk(const cli *c, const disk_need *needs, int n, bool warn_only, l2p_error *err)
 {
     double have[8], total[8];
     dev_t dev[8];
@@ -247,9 +268,17 @@ static int check_disk(const cli *c, const disk_need *needs, int n, l2p_error *er
                 break;
             }
     }
-    for (int i = 0; !st && i < n && i < 8; i++)
-        if (folder[i] && total[i] > have[i])
+    for (int i = 0; !st && i < n && i < 8; i++) {
+        char a[32], b[32];
+        if (!folder[i] || !(total[i] > have[i]))
+            continue;
+        if (!warn_only)
             st = refuse(c, "disk", total[i], have[i], folder[i], err);
+        else if (!c->quiet)
+            fprintf(stderr, "lens2pov: warning: through a lens whose ray field needs many faces "
+                    "this may take up to %s of disk in %s, %s available\n", human(total[i], a),
+                    folder[i], human(have[i], b));
+    }
     for (int i = 0; i < n && i < 8; i++)
         free(folder[i]);
     return st;
@@ -276,10 +305,14 @@ int size_check_trace(const cli *c, l2p_error *err)
 {
     if (c->no_size_check)
         return L2P_OK;
-    const size_estimate e = size_estimate_of(c, 0);
-    const disk_need needs[] = {{c->output, false, e.table_bytes},
-                               {c->rays_csv ? c->rays_csv : c->output, false, e.csv_bytes}};
-    return check_disk(c, needs, 2, err);
+    int st = L2P_OK;
+    for (int bound = 0; bound < (c->field_sampling ? 2 : 1) && !st; bound++) {
+        const size_estimate e = bound ? size_estimate_of(c, 0) : disk_estimate_of(c, 0);
+        const disk_need needs[] = {{c->output, false, e.table_bytes},
+                                   {c->rays_csv ? c->rays_csv : c->output, false, e.csv_bytes}};
+        st = check_disk(c, needs, 2, bound, err);
+    }
+    return st;
 }
 
 /* frames pictures, each from one table's renders; a kept folder (--keep-temp) keeps the
@@ -289,15 +322,19 @@ static int check_render(const cli *c, const char *work_dir, int jobs, int frames
 {
     if (c->no_size_check)
         return L2P_OK;
-    const size_estimate e = size_estimate_of(c, jobs);
     const bool kept = c->keep_temp != NULL;
-    /* Pixel sampling writes the CSV in the workspace, then moves (or copies) it to --rays. */
-    const double csv_work = e.csv_in_workspace ? e.csv_bytes : 0.0;
-    const double work = e.table_bytes * (kept ? tables : 1) + e.renders_bytes * (kept ? frames : 1);
-    const disk_need needs[] = {{work_dir, true, work + csv_work},
-                               {c->rays_csv ? c->rays_csv : c->output, false, e.csv_bytes},
-                               {c->output, false, crop_pixels(&c->cam) * 16.0 * frames}};
-    int st = check_disk(c, needs, 3, err);
+    int st = L2P_OK;
+    for (int bound = 0; bound < (c->field_sampling ? 2 : 1) && !st; bound++) {
+        const size_estimate d = bound ? size_estimate_of(c, jobs) : disk_estimate_of(c, jobs);
+        /* Pixel sampling writes the CSV in the workspace, then moves (or copies) it to --rays. */
+        const double csv_work = d.csv_in_workspace ? d.csv_bytes : 0.0;
+        const double work = d.table_bytes * (kept ? tables : 1) + d.renders_bytes * (kept ? frames : 1);
+        const disk_need needs[] = {{work_dir, true, work + csv_work},
+                                   {c->rays_csv ? c->rays_csv : c->output, false, d.csv_bytes},
+                                   {c->output, false, crop_pixels(&c->cam) * 16.0 * frames}};
+        st = check_disk(c, needs, 3, bound, err);
+    }
+    const size_estimate e = size_estimate_of(c, jobs);
     const double have = available_memory();
     if (!st && have > 0.0 && e.memory_bytes > have)
         st = refuse(c, "memory (POV-Ray's processes at once, or developing)", e.memory_bytes,

@@ -2,6 +2,7 @@
 #include "field/fieldpack.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include "field/field_render.h"
 #include "field/subimage.h"
 
@@ -91,6 +92,19 @@ static int render_count(const field_packed *subs, int spp, int w, int h, int job
         renders = (all + FIELD_FACES_PER_RENDER - 1) / FIELD_FACES_PER_RENDER;
     renders = (renders + jobs - 1) / jobs * jobs;
     return (int)(renders < spp ? renders : spp);
+}
+
+int field_pack_count_estimate(int spp, int w, int h, int jobs, double faces_per_sub,
+                              double frame_s)
+{
+    field_packed *subs = calloc((size_t)spp, sizeof *subs);
+    if (!subs)
+        return spp;
+    for (int i = 0; i < spp; i++)
+        subs[i].faces = (long long)ceil(faces_per_sub);
+    const int count = render_count(subs, spp, w, h, jobs, (long long)spp * subs[0].faces, frame_s);
+    free(subs);
+    return count;
 }
 
 /* Groups consecutive sub-images into renders, spread evenly over render_count of them, all

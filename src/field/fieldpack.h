@@ -27,6 +27,11 @@ typedef struct field_packed {
 int field_pack_grid(field_packed *subs, int spp, int w, int h, int jobs, double frame_s,
                     field_render_plan *plans);
 
+/* The number of renders field_pack_grid would make of spp sub-images of faces_per_sub faces
+   each: for estimates before the sub-images are built. */
+int field_pack_count_estimate(int spp, int w, int h, int jobs, double faces_per_sub,
+                              double frame_s);
+
 /* Pieces (adaptive sampling's second round, taller first: field_tiles_pieces) on shelves
    across renders as wide as the crop's. Returns the number of renders. */
 int field_pack_shelves(field_packed *subs, int n, int crop_w, int jobs, double frame_s,

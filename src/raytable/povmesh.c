@@ -1,9 +1,12 @@
 #include "raytable/povmesh.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 #include "raytable/chunk_ini.h"
 #include "raytable/chunk_name.h"
@@ -40,6 +43,7 @@ struct povmesh_emitter {
     char edge_text[POVMESH_RAY_TEXT_MAX];   /* the last shared edge's two vertex lines */
     size_t edge_len;
     vec3 anchor_camera_mm;     /* the front vertex: vertices are written relative to it */
+    struct timespec begun;     /* when the table was begun: the map's time (commit_map) */
     double triangle_size;      /* scene units */
     int decimals;
     double decimal_scale, fixed_limit;   /* quanta per scene unit; |v| written as integers */
@@ -301,6 +305,7 @@ int povmesh_open(povmesh_emitter **out, const camera *c, const char *prefix, con
         return l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
     }
     e->cam = c;
+    clock_gettime(CLOCK_REALTIME, &e->begun);
     e->anchor_camera_mm = v3(0, 0, c->lens.surface[0].vertex_z_mm);
     double widest = 0.0;
     for (int i = 0; i < c->lens.count; i++)
@@ -476,6 +481,20 @@ static int check_target(const outfile *f, l2p_error *err)
     return L2P_OK;
 }
 
+/* The map is renamed into place last, after chunks that render may have rendered already: it
+   takes the time the table was begun, so that develop finds every render of this trace newer
+   than its map, and one of an earlier trace older (develop_command.c, warn_older). */
+static int commit_map(povmesh_emitter *e, l2p_error *err)
+{
+    char *path = strdup(e->map.final_path);
+    int st = path ? outfile_commit(&e->map, err) : l2p_fail(err, L2P_FAILED, NULL, 0, "out of memory");
+    const struct timespec times[2] = {e->begun, e->begun};
+    if (!st && utimensat(AT_FDCWD, path, times, 0) != 0)
+        st = l2p_fail(err, L2P_FAILED, path, 0, "cannot set its time: %s", strerror(errno));
+    free(path);
+    return st;
+}
+
 static int commit_all(povmesh_emitter *e, l2p_error *err)
 {
     int st = check_target(&e->map, err);
@@ -489,7 +508,7 @@ static int commit_all(povmesh_emitter *e, l2p_error *err)
             st = outfile_commit(&e->chunks[i].ini, err);
     if (!st && e->has_csv)
         st = outfile_commit(&e->csv.file, err);
-    return st ? st : outfile_commit(&e->map, err);
+    return st ? st : commit_map(e, err);
 }
 
 int povmesh_close(povmesh_emitter *e, bool commit, int *chunk_count, l2p_error *err)
