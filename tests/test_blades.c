@@ -128,3 +128,22 @@ Test(blades, a_defocused_point_takes_the_shape_of_the_blades)
     }
     cr_expect(hi / lo < 1.01, "round stop: outline %.4f .. %.4f", lo, hi);
 }
+
+/* --blade-rotation turns blades: without --aperture-blades it changes nothing, and says so. */
+Test(blades, a_rotation_without_blades_is_warned_of)
+{
+    const char *dir = test_tmpdir();
+    char *errtext = NULL;
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--width", "8",
+                              "--height", "6", "--spp", "1", "-q", "--blade-rotation", "10", "-o",
+                              tmp_path(dir, "t"), NULL), 0, "%s", errtext);
+    cr_expect(strstr(errtext, "--blade-rotation 10 turns blades, and the stop has none"), "%s",
+              errtext);
+    free(errtext);
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--width", "8",
+                              "--height", "6", "--spp", "1", "-q", "--blade-rotation", "10",
+                              "--aperture-blades", "6", "-o", tmp_path(dir, "u"), NULL), 0, "%s",
+                 errtext);
+    cr_expect(!strstr(errtext, "--blade-rotation"), "%s", errtext);
+    free(errtext);
+}

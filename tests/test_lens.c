@@ -148,7 +148,8 @@ Test(lens, overlong_token)
 {
     REFUSED(FRONT STOP "-10 5 1 "
                        "1234567890123456789012345678901234567890123456789012345678901234567890\n",
-            3, "not a number: '12345678901234567890123456789012...'");
+            3, "a number of 70 characters, more than the 63 any decimal needs: "
+               "'12345678901234567890123456789012...'");
 }
 
 /* ---- rows that are numbers but not a surface -------------------------------------------- */

@@ -303,7 +303,7 @@ static const bad_lens BAD_LENSES[] = {
     {"50 5 1.5 20\n0 5 0 10\n\xff\xfe-50 0 1 20\n", 0, 3, "byte"},
     {"50 5 1.5 20\r\n0 5 0 10\r\n-50 0 1.5 20 40 x\r\n", 0, 3, "after the 5 numbers"},
     {"1234567890123456789012345678901234567890123456789012345678901234567890 5 1.5 20\n", 0, 1,
-     "not a number"},
+     "a number of 70 characters"},
     /* rows that read as numbers but make no lens */
     {"50 5 1 20\n0 5 0 10\n-50 0 1 20\n", 0, 1, "afocal"},
     {"50 1e300 1.5 20\n0 5 0 10\n-50 0 1 20\n", 0, -1, ""},
@@ -951,7 +951,7 @@ Test(robustness, render_killed_outright_leaves_no_povray_and_its_workspace_goes_
 }
 
 /* Every output is checked before any work: a missing folder, a folder where a file is
-   expected. Exit 2 with a message naming the path, nothing written, and before the tracing:
+   expected, a device. Exit 2 with a message naming the path, nothing written, and before the tracing:
    the 79 M samples asked for take far longer to trace and write, so a bound of 10 s leaves
    room for a sanitizer build on a loaded machine (2 s seen) and still tells the two apart. */
 Test(robustness, bad_output_paths_are_refused_before_any_work)
@@ -985,6 +985,8 @@ Test(robustness, bad_output_paths_are_refused_before_any_work)
         {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", keep_quote}, keep_quote},
         {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", keep_missing}, keep_missing},
         {{"render", scene, DGAUSS, "--width", "1280", "--height", "960", "--spp", "64", "-o", png, "--keep-temp", scene}, scene},
+        /* a device: nothing can be renamed onto it */
+        {{"trace", DGAUSS, "-o", out, "--rays", "/dev/null"}, "/dev/null: is not a regular file"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         const char *const *a = cases[i].args;

@@ -467,3 +467,48 @@ Test(scene_camera, an_include_of_a_computed_name_is_warned_of)
                                          "expression"), "%s", errtext ? errtext : "");
     free(errtext);
 }
+
+/* trace --scene takes POV-Ray's options after -- for reading the camera: a camera in a file
+   on a library path (+L) is found, and the table is the one --location and --look-at give
+   (byte for byte); without the path POV-Ray's error names the scene's line; options that make
+   an animation are refused, since trace writes one camera. */
+Test(scene_camera, trace_takes_povray_options_for_the_scene)
+{
+    const char *dir = test_tmpdir();
+    char lib[1024], scene[1100], plus_l[1100], prefix[1100];
+    snprintf(lib, sizeof lib, "%s/lib", dir);
+    cr_assert_eq(mkdir(lib, 0700), 0);
+    write_text(tmp_path(lib, "cam.inc"), "camera { location <1, 2, -6> look_at <0, 1, 0> }\n");
+    snprintf(scene, sizeof scene, "%s/s.pov", dir);
+    write_text(scene, "#version 3.7;\nglobal_settings { assumed_gamma 1 }\n#include \"cam.inc\"\n"
+                      "background { rgb 1 }\n");
+    snprintf(plus_l, sizeof plus_l, "+L%s", lib);
+    snprintf(prefix, sizeof prefix, "%s/a", dir);
+    run_lens2pov_ok("trace with +L", "trace", LENS_DIR "dgauss.50mm.dat", "--scene", scene,
+                    "--width", "16", "--height", "12", "--spp", "1", "-q", "-o", prefix, "--",
+                    plus_l, NULL);
+    snprintf(prefix, sizeof prefix, "%s/b", dir);
+    run_lens2pov_ok("trace placed", "trace", LENS_DIR "dgauss.50mm.dat", "--location", "1,2,-6",
+                    "--look-at", "0,1,0", "--width", "16", "--height", "12", "--spp", "1", "-q",
+                    "-o", prefix, NULL);
+    size_t na, nb;
+    char *a = read_text(tmp_path(dir, "a.inc"), &na), *b = read_text(tmp_path(dir, "b.inc"), &nb);
+    cr_expect(na == nb && memcmp(a, b, na) == 0, "the tables differ");
+    free(a), free(b);
+    char *errtext = NULL, want[1200];
+    snprintf(prefix, sizeof prefix, "%s/c", dir);
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--scene",
+                              scene, "-q", "-o", prefix, NULL), 2, "%s", errtext);
+    snprintf(want, sizeof want, "%s:3: Cannot find file 'cam.inc'", scene);
+    cr_expect(strstr(errtext, want), "%s", errtext);
+    free(errtext);
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "--scene",
+                              scene, "-q", "-o", prefix, "--", plus_l, "+KFI1", "+KFF3", NULL), 2,
+                 "%s", errtext);
+    cr_expect(strstr(errtext, "make 3 frames; trace writes one camera"), "%s", errtext);
+    free(errtext);
+    cr_expect_eq(run_lens2pov(NULL, &errtext, "trace", LENS_DIR "dgauss.50mm.dat", "-q", "-o",
+                              prefix, "--", plus_l, NULL), 2, "%s", errtext);
+    cr_expect(strstr(errtext, "only render, and trace --scene"), "%s", errtext);
+    free(errtext);
+}

@@ -108,6 +108,10 @@ static int check_target(const char *given, const char *path, l2p_error *err)
     struct stat sb;
     if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
         return l2p_fail(err, L2P_BAD_INPUT, given, 0, "cannot write: Is a directory");
+    /* A device or a pipe cannot be replaced by a file renamed onto it. */
+    if (stat(path, &sb) == 0 && !S_ISREG(sb.st_mode))
+        return l2p_fail(err, L2P_BAD_INPUT, given, 0, "is not a regular file: outputs are written "
+                        "beside their name and renamed onto it when complete; give a file name");
     const char *slash = strrchr(path, '/');
     char *dir = slash ? strndup(path, (size_t)(slash - path) + 1) : strdup(".");
     if (!dir)

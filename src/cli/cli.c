@@ -69,16 +69,17 @@ static const cli_option OPTIONS[] = {
      "  --jobs N                      POV-Ray processes at once [the cores]\n"},
     {"--memory-mb", NULL, CMD_TRACE, false, false,
      "  --memory-mb MB                split into chunks that fit a POV-Ray process of\n"
-     "                                this size [one include]\n"},
+     "                                this size (--sampling pixel) [one include]\n"},
     {"--memory-mb", NULL, CMD_RENDER, false, false,
-     "  --memory-mb MB                POV-Ray memory a process [1024]\n"},
+     "  --memory-mb MB                POV-Ray memory a process, --sampling pixel [1024]\n"},
     {"--rays", NULL, CMD_TRACE, false, false,
      "  --rays FILE.csv               every ray sent to POV-Ray [none]\n"},
     {"--rays", NULL, CMD_RENDER, false, false,
      "  --rays FILE.csv               every ray sent to POV-Ray; field sampling: every\n"
      "                                rendered pixel's exact ray and its render pixel [none]\n"},
     {"--scene", NULL, CMD_TRACE, false, false,
-     "  --scene SCENE.pov             place the lens as this scene's camera [none]\n"},
+     "  --scene SCENE.pov             place the lens as this scene's camera [none];\n"
+     "                                POV-Ray options it needs after --: +L, Declare=, ...\n"},
     {"--sampling", NULL, CMD_TRACE, false, false,
      "  --sampling pixel|field        exact rays, or ray fields: spp sub-images of shared\n"
      "                                samples drawn by coarse meshes [pixel]\n"},
@@ -586,6 +587,9 @@ void cli_warn(const cli *c, const camera *cam, bool picture)
 {
     cli_warn_wavelength(c, cam->lens.path, cam->glass);
     warn_axial_limit(cam);
+    if (c->cam.blade_rotation_deg != 0.0 && c->cam.aperture_blades == 0)
+        fprintf(stderr, "lens2pov: warning: --blade-rotation %g turns blades, and the stop has none "
+                        "(--aperture-blades N): it changes nothing\n", c->cam.blade_rotation_deg);
     /* A film nearer the lens than its focal plane images a virtual object: nothing in front of
        the lens is sharp. */
     if (!isnan(c->cam.film_distance_mm) && !(cam->focus_distance_units > 0.0))

@@ -7,12 +7,33 @@
 #include "camera/fieldangle.h"
 #include "povray/scenecam.h"
 
+/* trace --scene with POV-Ray's options (a library path, Declare=, an ini): the camera of the
+   one frame they render; an animation has a camera a frame, which only render follows. */
+static int camera_with_options(const cli *c, const char *scene, scene_camera *out,
+                               l2p_error *err)
+{
+    scene_frames sf;
+    int st = scene_frames_read(scene, c->cam.width, c->cam.height, c->povray_args,
+                               c->povray_arg_count, &sf, err);
+    if (st)
+        return st;
+    if (sf.count != 1)
+        st = l2p_fail(err, L2P_BAD_INPUT, scene, 0, "POV-Ray's options make %d frames; trace "
+                      "writes one camera: choose a frame (+SF and +EF), or render the animation",
+                      sf.count);
+    else
+        *out = sf.frame[0].cam;
+    scene_frames_free(&sf);
+    return st;
+}
+
 int framing_from_scene(cli *c, const char *scene, l2p_error *err)
 {
     if (c->placed && !c->angle_scene)
         return L2P_OK;
     scene_camera sc;
-    const int st = scene_camera_read(scene, c->cam.width, c->cam.height, &sc, err);
+    const int st = c->povray_args ? camera_with_options(c, scene, &sc, err)
+                                  : scene_camera_read(scene, c->cam.width, c->cam.height, &sc, err);
     if (!st) {
         framing_apply(c, &sc);
         framing_warn_perturbed(scene, sc.perturbed && !c->placed);

@@ -45,7 +45,8 @@ static const struct {
     {"plot", "usage: lens2pov plot LENS --what distortion|vignetting [camera options] -o FILE.png\n"
              "A gnuplot chart against film radius: distortion, the chief ray's image height\n"
              "against the paraxial one (percent); vignetting, the relative illumination\n"
-             "E(r)/E(0) at full aperture, f/4, f/8 and f/16. The table goes to stdout.\n"},
+             "E(r)/E(0) at the aperture given and at f/4, f/8 and f/16 where the lens\n"
+             "stops down to them. The table goes to stdout.\n"},
 };
 
 /* lens2pov COMMAND ... --help (or -h anywhere after the command): true when printed. */
@@ -92,8 +93,9 @@ int main(int argc, char **argv)
     if (st)
         return fail(&err);
     const char *cmd = argv[1];
-    if (c.povray_args && strcmp(cmd, "render")) {
-        l2p_fail(&err, L2P_BAD_INPUT, NULL, 0, "options after -- are POV-Ray's: only render takes them");
+    if (c.povray_args && strcmp(cmd, "render") && !(!strcmp(cmd, "trace") && c.scene)) {
+        l2p_fail(&err, L2P_BAD_INPUT, NULL, 0, "options after -- are POV-Ray's: only render, and "
+                 "trace --scene for reading the scene's camera, take them");
         return fail(&err);
     }
     if (!strcmp(cmd, "info"))

@@ -68,8 +68,9 @@ static int parse_number(const where *w, const char *token, size_t length, double
     const int quoted = length > QUOTE_MAX_CHARS ? QUOTE_MAX_CHARS : (int)length;
     const char *ellipsis = length > QUOTE_MAX_CHARS ? "..." : "";
     if (length > NUMBER_MAX_CHARS)
-        return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line, "not a number: '%.*s%s'",
-                        quoted, token, ellipsis);
+        return l2p_fail(w->err, L2P_BAD_INPUT, w->path, w->line, "a number of %zu characters, "
+                        "more than the %d any decimal needs: '%.*s%s'", length,
+                        NUMBER_MAX_CHARS, quoted, token, ellipsis);
     char text[NUMBER_MAX_CHARS + 1];
     memcpy(text, token, length);
     text[length] = '\0';
