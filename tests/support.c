@@ -18,6 +18,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 extern char **environ;
@@ -240,7 +241,14 @@ static int spawn_once(char *const argv[], char **out, char **errout)
     posix_spawn_file_actions_addopen(&fa, 1, o_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&fa, 2, e_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     pid_t pid;
-    cr_assert_eq(posix_spawn(&pid, bin, &fa, NULL, argv, environ), 0, "cannot run %s", bin);
+    /* A binary just linked can be busy for a moment (ETXTBSY), and a loaded machine can be out
+       of processes (EAGAIN): both pass. */
+    int e = posix_spawn(&pid, bin, &fa, NULL, argv, environ);
+    for (int tries = 0; (e == ETXTBSY || e == EAGAIN) && tries < 20; tries++) {
+        nanosleep(&(struct timespec){0, 50000000}, NULL);
+        e = posix_spawn(&pid, bin, &fa, NULL, argv, environ);
+    }
+    cr_assert_eq(e, 0, "cannot run %s: %s", bin, strerror(e));
     posix_spawn_file_actions_destroy(&fa);
     int status = 0;
     waitpid(pid, &status, 0);

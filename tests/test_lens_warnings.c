@@ -4,6 +4,7 @@
    of the library gets any, focused at infinity or at 2 m. */
 #include <criterion/criterion.h>
 #include <dirent.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,6 +51,27 @@ Test(lens_warnings, a_rim_that_limits_the_axial_beam_is_warned_of)
     errtext = info_with_camera(path, "inf", "3", &json);
     cr_expect(!strstr(errtext, "rim of this surface"), "%s", errtext);
     free(json), free(errtext);
+}
+
+/* A rear surface of 12 mm radius behind a 30 mm stop: beyond 6.2 mm of the stop's radius (41%:
+   a meridional trace in Python, film at the paraxial focus 18.519 mm behind) no ray from the
+   film's centre gets to the stop at all, missing the small sphere, so no rim can be named; the
+   lens still works slower than its stop says. Thick tracing has no rims and says nothing. */
+Test(lens_warnings, heights_of_the_stop_no_ray_reaches_are_warned_of)
+{
+    const char *dir = test_tmpdir(), *path = tmp_path(dir, "r12.dat");
+    write_text(path, "0 5 0 30\n50 8 1.5168 20\n-12 40 1 20\n");
+    char *json = NULL, *errtext = info_with_camera(path, "inf", NULL, &json), want[1400];
+    snprintf(want, sizeof want, "warning: %s: its surfaces, not the stop (line 1, 30 mm open), "
+             "limit the beam from the film's centre to 41%% of the stop's diameter: the lens "
+             "works at f/%.3g, not the f/%.3g its stop gives", path,
+             json_number(json, "working_f_number_traced"), json_number(json, "working_f_number"));
+    cr_expect(strstr(errtext, want), "%s\nwanted: %s", errtext, want);
+    free(json), free(errtext);
+    cr_assert_eq(run_lens2pov(NULL, &errtext, "info", path, "--focus-distance", "inf", "--trace",
+                              "thick", NULL), 0, "%s", errtext);
+    cr_expect(!strstr(errtext, "not the stop"), "%s", errtext);
+    free(errtext);
 }
 
 Test(lens_warnings, a_film_in_glass_is_warned_of_at_its_line)
@@ -99,4 +121,18 @@ Test(lens_warnings, no_library_lens_gets_either)
     }
     closedir(d);
     cr_expect_geq(seen, 10);
+}
+
+/* A stop just past the singlet's front focal plane puts the exit pupil far behind the film: at
+   infinity focus the paraxial working f-number is still the f-number (from the entrance pupil
+   and the focal length), positive, as the exit pupil's distance over its diameter gives it. */
+Test(lens_warnings, an_exit_pupil_behind_the_film_gives_the_f_number)
+{
+    const char *dir = test_tmpdir(), *path = tmp_path(dir, "tele.dat");
+    write_text(path, "0 47.54 0 20\n50 5 1.5168 12\n-50 40 1 12\n");
+    char *json = NULL, *errtext = info_with_camera(path, "inf", NULL, &json);
+    const double working = json_number(json, "working_f_number");
+    const double n = json_number(json, "f_number");
+    cr_expect(working > 0.0 && fabs(working / n - 1.0) < 1e-6, "working f/%g, f/%g", working, n);
+    free(json), free(errtext);
 }

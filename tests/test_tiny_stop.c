@@ -136,6 +136,7 @@ static const char *const LENSES[] = {"dgauss.50mm", "wide.22mm", "fisheye.10mm",
 Test(tiny_stop, the_light_of_a_tiny_stop_is_found_and_measured)
 {
     const double diameters_mm[] = {1e-3, 1e-5, 1e-7};
+    int compared = 0;   /* film points where the lens passes the sliver whole */
     for (int li = 0; li < 5; li++)
         for (int di = 0; di < 3; di++) {
             camera_options o;
@@ -153,6 +154,7 @@ Test(tiny_stop, the_light_of_a_tiny_stop_is_found_and_measured)
                 const double want = tiny_irradiance(&c.lens, p, 0.5 * diameters_mm[di]);
                 if (isnan(want))
                     continue;
+                compared += want > 0.0;
                 enum { SIDE = 32 };
                 double sum = 0.0;
                 int passed = 0;
@@ -174,6 +176,8 @@ Test(tiny_stop, the_light_of_a_tiny_stop_is_found_and_measured)
             }
             camera_free(&c);
         }
+    /* 135 points in all; the fisheye's and the Petzval's outer ones lie beyond their reach */
+    cr_expect_geq(compared, 100, "only %d film points compared", compared);
 }
 
 /* The share of "N of M rays pass" in trace's report. */
@@ -218,6 +222,16 @@ Test(tiny_stop, a_stop_that_few_samples_pass_is_warned_of)
                               "--f-number", "16", "--sampling", "pixel", "-o",
                               tmp_path(dir, "f16"), NULL), 0, "%s", errtext);
     cr_expect(!strstr(errtext, "get through the lens"), "%s", errtext);
+    free(out), free(errtext);
+    /* so small that its f-number overflows and the lens reaches no film point: still said, and
+       no inf or nan printed */
+    cr_assert_eq(run_lens2pov(&out, &errtext, "trace", lens, "--width", "8", "--height", "6",
+                              "--aperture-diameter", "1e-307", "--weighting", "physical",
+                              "--dispersion", "off", "-o", tmp_path(dir, "zero"), NULL), 0, "%s",
+                 errtext);
+    cr_expect(strstr(errtext, "the picture will be black") &&
+              strstr(errtext, "would blur every point over the whole film") &&
+              !strstr(errtext, "inf ") && !strstr(errtext, "nan"), "%s", errtext);
     free(out), free(errtext);
     remove_tree(dir);
 }

@@ -36,6 +36,16 @@ static void render(const char *dir, const char *ini, const char *inc)
     cr_assert_eq(system_povray(cmd), 0, "POV-Ray on %s", ini);
 }
 
+/* Two 24 x 18 pictures in dir, RGBA. */
+static void read_both(const char *dir, const char *first, const char *second, float **a, float **b)
+{
+    int w, h, w2, h2;
+    l2p_error err;
+    cr_assert_eq(image_read_rgba(tmp_path(dir, first), &w, &h, a, &err), 0, "%s", err.text);
+    cr_assert_eq(image_read_rgba(tmp_path(dir, second), &w2, &h2, b, &err), 0, "%s", err.text);
+    cr_assert(w == 24 && h == 18 && w2 == w && h2 == h, "%dx%d and %dx%d", w, h, w2, h2);
+}
+
 /* PREFIX = DIR/p (tmp_path's buffers rotate, so it gets its own) traced as one table and
    rendered through POV-Ray. */
 static void trace_and_render(const char *dir, char *prefix, size_t size)
@@ -63,12 +73,8 @@ Test(trace_set, one_chunk_asked_for_is_developed_by_its_own_name)
     free(errtext);
     run_lens2pov_ok("develop, the render named", "develop", prefix, tmp_path(dir, "p.c000.exr"), "-o",
                     tmp_path(dir, "b.exr"), (char *)NULL);
-    int w, h, w2, h2;
     float *a, *b;
-    l2p_error err;
-    cr_assert_eq(image_read_rgba(tmp_path(dir, "a.exr"), &w, &h, &a, &err), 0, "%s", err.text);
-    cr_assert_eq(image_read_rgba(tmp_path(dir, "b.exr"), &w2, &h2, &b, &err), 0, "%s", err.text);
-    cr_assert(w == 24 && h == 18 && w2 == w && h2 == h);
+    read_both(dir, "a.exr", "b.exr", &a, &b);
     cr_assert(memcmp(a, b, sizeof *a * 4 * 24 * 18) == 0, "the two pictures differ");
     free(a), free(b);
 }
@@ -121,7 +127,7 @@ Test(trace_set, develop_warns_of_a_render_older_than_its_map)
        black: a_render_through_the_scenes_own_camera_is_refused) */
     const int st = run_lens2pov(NULL, &errtext, "develop", prefix, "-o", tmp_path(dir, "b.png"),
                                 (char *)NULL);
-    cr_assert(st == 0 || st == 2, "%d: %s", st, errtext);
+    cr_assert(st == 0 || (st == 2 && strstr(errtext, "is not black")), "%d: %s", st, errtext);
     cr_expect(errtext && strstr(errtext, "p.exr is older than") && strstr(errtext, "p.map"), "%s",
               errtext ? errtext : "(nothing on stderr)");
     free(errtext);
@@ -177,12 +183,8 @@ Test(trace_set, a_hand_render_sees_the_films_size_as_render_does)
         run_lens2pov_ok("render", "render", scene, DGAUSS, "--width", "24", "--height", "18",
                         "--spp", "2", "--quiet", "--sampling", sampling[s], "-o",
                         tmp_path(dir, "render.exr"), (char *)NULL);
-        int w, h, w2, h2;
         float *a, *b;
-        l2p_error err;
-        cr_assert_eq(image_read_rgba(tmp_path(dir, "hand.exr"), &w, &h, &a, &err), 0, "%s", err.text);
-        cr_assert_eq(image_read_rgba(tmp_path(dir, "render.exr"), &w2, &h2, &b, &err), 0, "%s", err.text);
-        cr_assert(w == 24 && h == 18 && w2 == w && h2 == h);
+        read_both(dir, "hand.exr", "render.exr", &a, &b);
         cr_expect(a[4 * (9 * 24 + 12)] > 0.5 && a[4 * (9 * 24 + 12) + 2] == 0.0,
                   "%s: the hand render's centre is not red: %g %g %g", sampling[s],
                   a[4 * (9 * 24 + 12)], a[4 * (9 * 24 + 12) + 1], a[4 * (9 * 24 + 12) + 2]);

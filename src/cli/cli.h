@@ -45,9 +45,11 @@ int cli_parse(cli *c, int argc, char **argv, int first, l2p_error *err);
 /* The lines of COMMAND --help that list its options: the same table the parser accepts. */
 void cli_print_options(FILE *out, const char *command);
 
-/* Warns on stderr about choices that give a picture the user may not expect: a film distance
-   that puts the focus behind the camera, and for a command that makes a picture (trace and
-   render), --pupil stop (biased on purpose) and a stop where diffraction would show. */
+/* Warns on stderr about choices that give a picture the user may not expect (warnings.c): a
+   rim that limits the axial beam more than the stop, --blade-rotation without blades, a film
+   distance that puts the focus behind the camera, and for a command that makes a picture
+   (trace and render), --pupil stop (biased on purpose), a stop where diffraction would show,
+   and a lens that passes few of the samples. */
 void cli_warn(const cli *c, const camera *cam, bool picture);
 /* Warns that --wavelength changes nothing on a lens without Abbe numbers (glass false). */
 void cli_warn_wavelength(const cli *c, const char *lens_path, bool glass);

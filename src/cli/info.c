@@ -65,7 +65,7 @@ double info_working_f_number(const camera *c)
     l2p_error ignored;
     if (pupil_stop_image(&c->lens, true, &z, &r, &ignored) || !(r > 0.0))
         return NAN;
-    return z / (2.0 * r);
+    return fabs(z) / (2.0 * r);   /* a pupil behind the film too (z < 0) */
 }
 
 typedef struct field { const char *key, *label, *unit; double value; } field;

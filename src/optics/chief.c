@@ -142,10 +142,10 @@ bool chief_angle(const chief_lens *c, double film_radius_mm, double *theta_rad)
    l; *blocked the surface that stops it. From slope *t, left at the aimed slope. */
 static bool axial_passes(const chief_lens *c, const lens *l, double h_mm, double *t, int *blocked)
 {
+    *blocked = -1;   /* none known: no ray from the centre gets to that height at all */
     if (!newton_to(&c->open, 0.0, h_mm, t))
         return false;
     ray y = from_film(0.0, *t);
-    *blocked = -1;
     return trace_toward_scene(l, 0, l->count - 1, &y, blocked) == TRACE_PASSED;
 }
 
@@ -163,8 +163,6 @@ int chief_axial_limit(const chief_lens *c, const lens *l, double *passing)
     const double t_rim = t;
     if (axial_passes(c, l, rim_mm, &t, &blocked))
         return l->stop;
-    if (blocked < 0)
-        return -1;
     int limit = blocked;   /* the rim that cuts the ray just outside the passing cone */
     double in = 0.0, out = 1.0;
     for (int k = 0; k < 30; k++) {
@@ -172,10 +170,8 @@ int chief_axial_limit(const chief_lens *c, const lens *l, double *passing)
         t = t_rim * mid;
         if (axial_passes(c, l, mid * rim_mm, &t, &blocked))
             in = mid;
-        else if (blocked >= 0)
-            out = mid, limit = blocked;
-        else
-            return -1;
+        else if ((out = mid), blocked >= 0)
+            limit = blocked;
     }
     *passing = in;
     return limit;

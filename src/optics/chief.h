@@ -37,7 +37,8 @@ bool chief_angle(const chief_lens *c, double film_radius_mm, double *theta_rad);
 /* The surface whose rim limits the beam from the film's centre, for lens l at its opening (c
    opened from it): the stop's index when the stop does, another when the ray toward the
    stop's rim is cut before or after it, with *passing the share of the stop's radius whose
-   rays get through; -1 when that ray cannot be aimed. Blades are not rims: a polygon inside
+   rays get through; -1 when no ray of the film's centre meets a rim (the stop's image at
+   infinity, or heights of the stop no ray gets to). Blades are not rims: a polygon inside
    the stop's circle is the stop still. */
 int chief_axial_limit(const chief_lens *c, const lens *l, double *passing);
 

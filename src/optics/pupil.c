@@ -173,10 +173,8 @@ static double chief_x_at(const pupil *pu, double r_mm)
    the two nodes' offsets from theirs (pupil.h). */
 static double centre_at(const pupil *pu, double r_mm, int j, double f)
 {
-    const int per_node = PUPIL_CHIEF_SAMPLES / PUPIL_NODES;
-    const double *chief = pu->chief_spacing_mm > 0.0 ? pu->chief_x_mm : NULL;
-    const double a = pu->node[j].centre_mm - (chief ? chief[j * per_node] : 0.0);
-    const double b = pu->node[j + 1].centre_mm - (chief ? chief[(j + 1) * per_node] : 0.0);
+    const double a = pu->node[j].centre_mm - pupil_chief_at_node(pu, j);
+    const double b = pu->node[j + 1].centre_mm - pupil_chief_at_node(pu, j + 1);
     return chief_x_at(pu, r_mm) + a + f * (b - a);
 }
 

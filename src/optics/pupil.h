@@ -77,6 +77,12 @@ void pupil_fit(pupil *pu, const lens *l, double film_radius_mm);
 /* The growth every fitted shape gets last (pupil_fit.c says why). */
 #define PUPIL_FIT_MARGIN 1.004
 
+/* The chief ray's crossing at node j's film radius (pupil.h's table), 0 without the table. */
+static inline double pupil_chief_at_node(const pupil *pu, int j)
+{
+    return pu->chief_spacing_mm > 0.0 ? pu->chief_x_mm[j * (PUPIL_CHIEF_SAMPLES / PUPIL_NODES)] : 0.0;
+}
+
 /* Whether pu was fitted (pupil_fit). */
 static inline bool pupil_is_fitted(const pupil *pu) { return pu->node_spacing_mm > 0.0; }
 

@@ -307,12 +307,6 @@ static void grow(pupil_shape *e, double factor)
         e->radius_mm[i] *= factor;
 }
 
-/* The chief ray's crossing at node j, 0 without the table. */
-static double chief_at_node(const pupil *pu, int j)
-{
-    return pu->chief_spacing_mm > 0.0 ? pu->chief_x_mm[j * (PUPIL_CHIEF_SAMPLES / PUPIL_NODES)] : 0.0;
-}
-
 /* The nodes' shapes where the region is found; found[j] says where. The guess for each node
    continues the two before it, or with the chief rays tabulated, the chief ray's crossing
    moved by the last node's offset from it. */
@@ -322,7 +316,7 @@ static void fit_nodes(pupil *pu, const lens *l, bool *found)
     double guess = 0.0, size = pu->radius_mm, offset = 0.0;
     for (int j = 0; j <= PUPIL_NODES; j++) {
         if (chief)
-            guess = chief_at_node(pu, j) + offset;
+            guess = pupil_chief_at_node(pu, j) + offset;
         const region g = find_region(pu, l, j * pu->node_spacing_mm, guess, size);
         found[j] = g.found;
         if (!g.found)
@@ -332,7 +326,7 @@ static void fit_nodes(pupil *pu, const lens *l, bool *found)
             pu->node[0] = disk(size_of(&pu->node[0]));
         const double previous = j > 0 && found[j - 1] ? pu->node[j - 1].centre_mm : pu->node[j].centre_mm;
         guess = 2.0 * pu->node[j].centre_mm - previous;
-        offset = pu->node[j].centre_mm - chief_at_node(pu, j);
+        offset = pu->node[j].centre_mm - pupil_chief_at_node(pu, j);
         size = size_of(&pu->node[j]);
     }
 }
@@ -352,7 +346,7 @@ static double find_reach(pupil *pu, const lens *l, const bool *found)
     for (int j = 1; j <= PUPIL_NODES; j++)
         if (!found[j]) {
             pu->node[j] = pu->node[j - 1];
-            pu->node[j].centre_mm += chief_at_node(pu, j) - chief_at_node(pu, j - 1);
+            pu->node[j].centre_mm += pupil_chief_at_node(pu, j) - pupil_chief_at_node(pu, j - 1);
         }
     if (last < 0 || last == PUPIL_NODES)
         return INFINITY;
