@@ -1,4 +1,4 @@
-/* With dispersion, the pupils samples are drawn from at each wavelength (camera.h). */
+/* With dispersion, the pupils that samples are drawn from at each wavelength (spectral.h). */
 #include "camera/spectral.h"
 
 #include <math.h>
