@@ -448,3 +448,10 @@ double json_number(const char *json, const char *key)
     cr_assert(end != p + strlen(quoted), "%s is not a number", key);
     return v;
 }
+
+void expect_attribute(const char *path, const char *key, const char *want)
+{
+    char value[256];
+    cr_assert_eq(image_get_attribute(path, key, value, sizeof value), L2P_OK, "%s: no %s", path, key);
+    cr_assert_str_eq(value, want, "%s: %s", path, key);
+}

@@ -46,6 +46,8 @@ const char *tmp_path(const char *dir, const char *name);
 /* Writes text, or length bytes, to path (exact bytes); reads a whole file (malloc'd, with a
    NUL after it; NULL when it cannot be read). */
 void write_text(const char *path, const char *text);
+/* Fails the test unless the picture at path has attribute key, with the value want. */
+void expect_attribute(const char *path, const char *key, const char *want);
 void write_bytes(const char *path, const char *data, size_t length);
 char *read_text(const char *path, size_t *length);
 

@@ -242,14 +242,10 @@ Test(develop, files_end_to_end)
                                1e-3 * fabsf(want[3 * i + c]) + 1e-6);
     free(got);
     char value[256];
-    cr_assert_eq(image_get_attribute(out, "lens2pov:lens", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "Double Gauss 50mm f/2");
-    cr_assert_eq(image_get_attribute(out, "lens2pov:spp", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "2");
-    cr_assert_eq(image_get_attribute(out, "lens2pov:focus_distance", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "3.25");
-    cr_assert_eq(image_get_attribute(out, "Software", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "lens2pov");
+    expect_attribute(out, "lens2pov:lens", "Double Gauss 50mm f/2");
+    expect_attribute(out, "lens2pov:spp", "2");
+    expect_attribute(out, "lens2pov:focus_distance", "3.25");
+    expect_attribute(out, "Software", "lens2pov");
     cr_assert_eq(image_get_attribute(out, "Exif:FNumber", value, sizeof value), L2P_OK);
     cr_assert_float_eq(atof(value), 2.8, 1e-6);
     samplemap_free(&m);

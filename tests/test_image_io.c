@@ -87,8 +87,7 @@ Test(image_io, tiff_16bit_round_trip)
     free(px);
     char value[64];
     /* TIFF keeps no attributes of our own: they come back from ImageDescription */
-    cr_assert_eq(image_get_attribute(path, "lens2pov:lens", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "Fisheye");
+    expect_attribute(path, "lens2pov:lens", "Fisheye");
     cr_assert_eq(image_get_attribute(path, "FNumber", value, sizeof value), L2P_OK);
     cr_assert_float_eq(atof(value), 5.6, 1e-6);
 }
@@ -104,12 +103,9 @@ Test(image_io, png_metadata)
     l2p_error err = {0, ""};
     cr_assert_eq(image_write_rgb(path, 1, 1, rgb, attrs, 4, &err), L2P_OK, "%s", err.text);
     char value[64];
-    cr_assert_eq(image_get_attribute(path, "lens2pov:pupil", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "");
-    cr_assert_eq(image_get_attribute(path, "lens2pov:lens", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "Wide angle");
-    cr_assert_eq(image_get_attribute(path, "Software", value, sizeof value), L2P_OK);
-    cr_assert_str_eq(value, "lens2pov");
+    expect_attribute(path, "lens2pov:pupil", "");
+    expect_attribute(path, "lens2pov:lens", "Wide angle");
+    expect_attribute(path, "Software", "lens2pov");
     cr_assert_eq(image_get_attribute(path, "FNumber", value, sizeof value), L2P_OK);
     cr_assert_float_eq(atof(value), 2.8, 1e-6);
     cr_assert_eq(image_get_attribute(path, "lens2pov:absent", value, sizeof value), L2P_FAILED);
